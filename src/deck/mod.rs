@@ -1,0 +1,2 @@
+//! The deck: text → raw cards (syntax) → [`crate::model::Model`] (meaning).
+//! (Being written; see `grammar.md`.)

@@ -1,0 +1,13 @@
+//! mecano-rs: a flexible multibody dynamics code in the line of MECANO (Géradin & Cardona).
+//!
+//! Data flows one way: [`deck`] (text → cards → [`model::Model`]) → [`elements`]
+//! (residual, tangent and mass of each element) → [`solver`] (HHT time integration,
+//! Newton, sparse linear algebra) → [`output`] (per-node CSV histories, `summary.json`).
+#![warn(missing_docs)]
+
+pub mod deck;
+pub mod elements;
+pub mod model;
+pub mod output;
+pub mod rotation;
+pub mod solver;

@@ -1,0 +1,429 @@
+//! The numbered, validated model: what a deck means.
+//!
+//! Built from the raw cards of [`crate::deck`] by [`crate::deck::build_model`]; every
+//! reference is resolved (a [`NodeId`] in an element is known to exist), every default
+//! applied and every range checked. The solver reads a `Model` and nothing else.
+//!
+//! **Invariant:** maps keep deck order; keys are the user's numbers.
+
+mod ids;
+mod summary;
+
+pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
+pub use summary::{Effects, Summary};
+
+use indexmap::IndexMap;
+use nalgebra::{Matrix3, Vector3};
+
+/// A byte range in the deck's source text (for diagnostics that point back to the deck).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Span {
+    /// First byte.
+    pub start: usize,
+    /// One past the last byte.
+    pub end: usize,
+}
+
+impl Span {
+    /// A span from `start` to `end` (bytes).
+    pub fn new(start: usize, end: usize) -> Self {
+        Span { start, end }
+    }
+}
+
+/// Which of a node's six degrees of freedom are fixed: `[x, y, z, rx, ry, rz]`.
+pub type Fixity = [bool; 6];
+
+/// A node: reference position and the degrees of freedom held fixed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// The user's number.
+    pub id: NodeId,
+    /// Reference (initial) position, global frame, m.
+    pub position: Vector3<f64>,
+    /// Fixed degrees of freedom `[x, y, z, rx, ry, rz]`.
+    pub fixed: Fixity,
+    /// Where the node was defined.
+    pub span: Span,
+}
+
+/// An isotropic linear-elastic material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// The user's number.
+    pub id: MaterialId,
+    /// Young's modulus E, N/m² (> 0).
+    pub young: f64,
+    /// Shear modulus G, N/m² (> 0); from `G = E / (2(1+ν))` when ν is given.
+    pub shear: f64,
+    /// Density ρ, kg/m³ (≥ 0).
+    pub density: f64,
+    /// Stiffness-proportional (Rayleigh) damping coefficient, s (≥ 0; 0 = none).
+    pub damping: f64,
+    /// Where the material was defined.
+    pub span: Span,
+}
+
+/// A beam cross-section.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Section {
+    /// The user's number.
+    pub id: SectionId,
+    /// Area A, m².
+    pub area: f64,
+    /// Second moment about local axis 2, I2, m⁴.
+    pub i2: f64,
+    /// Second moment about local axis 3, I3, m⁴.
+    pub i3: f64,
+    /// Torsion constant J, m⁴.
+    pub torsion: f64,
+    /// Shear correction factor k (default 5/6).
+    pub shear_factor: f64,
+    /// A rigid section: the bar keeps its shape (its mass still comes from ρA).
+    pub rigid: bool,
+    /// Where the section was defined.
+    pub span: Span,
+}
+
+/// A time function `f(t)` that scales a load.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Function {
+    /// Piecewise-linear table of `(t, f)` with non-decreasing `t`; constant beyond its ends.
+    Table(Vec<(f64, f64)>),
+    /// A constant value.
+    Constant(f64),
+}
+
+impl Function {
+    /// Value at time `t`.
+    pub fn eval(&self, t: f64) -> f64 {
+        match self {
+            Function::Constant(c) => *c,
+            Function::Table(pts) => {
+                let Some(first) = pts.first() else { return 0.0 };
+                if t <= first.0 {
+                    return first.1;
+                }
+                for w in pts.windows(2) {
+                    let (t0, f0) = w[0];
+                    let (t1, f1) = w[1];
+                    if t <= t1 {
+                        if t1 > t0 {
+                            return f0 + (f1 - f0) * (t - t0) / (t1 - t0);
+                        }
+                        return f1;
+                    }
+                }
+                pts[pts.len() - 1].1
+            }
+        }
+    }
+
+    /// Times where the function has kinks (table breakpoints), which a time integrator
+    /// should step on rather than across.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        match self {
+            Function::Constant(_) => Vec::new(),
+            Function::Table(p) => p.iter().map(|x| x.0).collect(),
+        }
+    }
+}
+
+/// A named function with its span.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FunctionDef {
+    /// The user's number.
+    pub id: FunctionId,
+    /// The function.
+    pub function: Function,
+    /// Where it was defined.
+    pub span: Span,
+}
+
+/// A planar curve of a CAME profile, in its node's local frame (plane of local axes 1–2,
+/// extruded along local axis 3).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Profile {
+    /// A single point at `offset`.
+    Point,
+    /// A straight line through `offset` along local direction `(cos θ, sin θ)`, θ the
+    /// profile's in-plane angle.
+    Line,
+    /// A circle of radius `r` centred at `offset`.
+    Circle {
+        /// Radius, m (> 0).
+        radius: f64,
+    },
+    /// A cubic spline through points (local plane coordinates, m).
+    Spline {
+        /// Interpolated points (at least 2; at least 3 when closed).
+        points: Vec<[f64; 2]>,
+        /// Closed (periodic) curve.
+        closed: bool,
+    },
+}
+
+/// A profile placed in its node's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlacedProfile {
+    /// The curve.
+    pub profile: Profile,
+    /// Offset of the profile's origin from the node, in the node's local frame, m.
+    pub offset: Vector3<f64>,
+    /// Orientation of the profile plane in the node frame: the profile's local axes
+    /// (columns) expressed in the node frame. Identity by default: profile plane = node's
+    /// 1–2 plane, extrusion along axis 3.
+    pub frame: Matrix3<f64>,
+}
+
+/// Data of a CAME (cam–follower contact) element.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameData {
+    /// Contact stiffness `k_cont`, N/m (> 0).
+    pub stiffness: f64,
+    /// Contact damping `c_cont`, N·s/m (≥ 0).
+    pub damping: f64,
+    /// Coulomb friction coefficient μ (≥ 0; 0 = frictionless).
+    pub friction: f64,
+    /// Regularisation speed of friction, m/s (> 0).
+    pub friction_speed: f64,
+    /// Clip the tensile (adhesive) part of the force at the end of an impact.
+    pub clip_tension: bool,
+    /// Minimum number of time steps that must resolve each impact (adaptive cutting).
+    pub impact_steps: u32,
+    /// The cam's profile, on the first node.
+    pub cam: PlacedProfile,
+    /// The follower's profile, on the second node.
+    pub follower: PlacedProfile,
+}
+
+/// What an element is, with its type-specific data.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ElementKind {
+    /// Geometrically exact two-node beam.
+    Beam {
+        /// Material.
+        material: MaterialId,
+        /// Section.
+        section: SectionId,
+        /// Direction of the section's local axis 2 in the reference configuration
+        /// (global); `None` = the documented default.
+        axis2: Option<Vector3<f64>>,
+    },
+    /// A point mass with optional rotary inertia (global frame at t = 0).
+    Mass {
+        /// Mass, kg (≥ 0).
+        mass: f64,
+        /// Rotary inertia tensor about the node, kg·m², global frame at t = 0.
+        inertia: Matrix3<f64>,
+    },
+    /// Revolute joint: rotation only about `axis` (global at t = 0).
+    Hinge {
+        /// Hinge axis (unit), global frame at t = 0.
+        axis: Vector3<f64>,
+    },
+    /// Universal (Cardan) joint: `axis1` fixed to the first node, `axis2` to the second;
+    /// perpendicular at t = 0.
+    UJoint {
+        /// Axis on the first body (unit), global at t = 0.
+        axis1: Vector3<f64>,
+        /// Axis on the second body (unit), global at t = 0.
+        axis2: Vector3<f64>,
+    },
+    /// Spherical joint: relative translation blocked.
+    Spherical,
+    /// Two nodes welded: no relative motion.
+    Clamp,
+    /// Prismatic joint: relative rotation blocked, translation only along `axis`.
+    Prismatic {
+        /// Sliding axis (unit), global at t = 0.
+        axis: Vector3<f64>,
+    },
+    /// A rigid body: all listed nodes move with the first one.
+    Rigid,
+    /// Cam–follower contact (first node: cam, second: follower).
+    Came(Box<CameData>),
+}
+
+impl ElementKind {
+    /// The deck keyword of this element type.
+    pub fn keyword(&self) -> &'static str {
+        match self {
+            ElementKind::Beam { .. } => "BEAM",
+            ElementKind::Mass { .. } => "MASS",
+            ElementKind::Hinge { .. } => "HINGE",
+            ElementKind::UJoint { .. } => "UJOINT",
+            ElementKind::Spherical => "SPHERICAL",
+            ElementKind::Clamp => "CLAMP",
+            ElementKind::Prismatic { .. } => "PRISMATIC",
+            ElementKind::Rigid => "RIGID",
+            ElementKind::Came(_) => "CAME",
+        }
+    }
+
+    /// Number of constraint equations (Lagrange multipliers) the element adds.
+    pub fn constraint_count(&self, node_count: usize) -> usize {
+        match self {
+            ElementKind::Hinge { .. } => 5,
+            ElementKind::UJoint { .. } => 4,
+            ElementKind::Spherical => 3,
+            ElementKind::Clamp => 6,
+            ElementKind::Prismatic { .. } => 5,
+            ElementKind::Rigid => 6 * node_count.saturating_sub(1),
+            _ => 0,
+        }
+    }
+}
+
+/// An element: number, type, nodes (in the order the type defines).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Element {
+    /// The user's number.
+    pub id: ElementId,
+    /// Connected nodes.
+    pub nodes: Vec<NodeId>,
+    /// Type and data.
+    pub kind: ElementKind,
+    /// Where it was defined.
+    pub span: Span,
+}
+
+/// A nodal load `value · f(t)` in the global frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodalLoad {
+    /// Loaded node.
+    pub node: NodeId,
+    /// `true` = moment (N·m), `false` = force (N).
+    pub moment: bool,
+    /// Components, global frame.
+    pub value: Vector3<f64>,
+    /// Time function scaling the load; `None` = constant 1.
+    pub function: Option<FunctionId>,
+    /// Where it was defined.
+    pub span: Span,
+}
+
+/// Newton–Raphson settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NewtonSettings {
+    /// Tolerance on the residual, relative to the model's reference force (default 1e-8).
+    pub tol_residual: f64,
+    /// Tolerance on the increment, relative to the model's reference length (default 1e-10).
+    pub tol_increment: f64,
+    /// Iteration limit per step (default 20).
+    pub max_iterations: u32,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        NewtonSettings {
+            tol_residual: 1e-8,
+            tol_increment: 1e-10,
+            max_iterations: 20,
+        }
+    }
+}
+
+/// Adaptive time stepping settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Adaptive {
+    /// Local error tolerance on positions, m.
+    pub tol_position: f64,
+    /// Local error tolerance on rotations, rad.
+    pub tol_rotation: f64,
+    /// Largest step growth factor per step (default 2).
+    pub max_growth: f64,
+}
+
+/// The analysis to run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Analysis {
+    /// Implicit dynamics with HHT.
+    Dynamic {
+        /// HHT α ∈ [−1/3, 0].
+        alpha: f64,
+        /// Time step h (initial step when adaptive), s.
+        step: f64,
+        /// End time, s.
+        end: f64,
+        /// Smallest step allowed when cutting, s (default h/1024).
+        min_step: f64,
+        /// Largest step when adaptive, s (default = step).
+        max_step: f64,
+        /// Adaptive stepping; `None` = fixed steps.
+        adaptive: Option<Adaptive>,
+        /// Newton settings.
+        newton: NewtonSettings,
+    },
+    /// Static equilibrium with load steps (loads scaled by their functions at
+    /// `t = i / steps`, i = 1..steps).
+    Static {
+        /// Number of load steps (≥ 1).
+        steps: u32,
+        /// Newton settings.
+        newton: NewtonSettings,
+    },
+}
+
+/// Which entities an output request covers.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Selection<T> {
+    /// All of them.
+    All,
+    /// These ones.
+    List(Vec<T>),
+    /// None.
+    None,
+}
+
+/// What to write and where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputRequest {
+    /// Nodes whose histories are written (`node_<N>.csv`).
+    pub nodes: Selection<NodeId>,
+    /// Elements whose histories are written (`element_<N>.csv`).
+    pub elements: Selection<ElementId>,
+    /// Write a row every this many steps (≥ 1).
+    pub every: u32,
+    /// Output directory from the deck (the command line's `-o` wins).
+    pub dir: Option<String>,
+    /// Also write a ParaView `.pvd` series of VTK files.
+    pub vtk: bool,
+}
+
+impl Default for OutputRequest {
+    fn default() -> Self {
+        OutputRequest {
+            nodes: Selection::All,
+            elements: Selection::All,
+            every: 1,
+            dir: None,
+            vtk: false,
+        }
+    }
+}
+
+/// A validated model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// The deck's title.
+    pub title: String,
+    /// Nodes in deck order.
+    pub nodes: IndexMap<NodeId, Node>,
+    /// Materials in deck order.
+    pub materials: IndexMap<MaterialId, Material>,
+    /// Sections in deck order.
+    pub sections: IndexMap<SectionId, Section>,
+    /// Time functions in deck order.
+    pub functions: IndexMap<FunctionId, FunctionDef>,
+    /// Elements in deck order.
+    pub elements: IndexMap<ElementId, Element>,
+    /// Nodal forces and moments.
+    pub loads: Vec<NodalLoad>,
+    /// Gravity acceleration vector, m/s²; `None` = no gravity.
+    pub gravity: Option<Vector3<f64>>,
+    /// The analysis.
+    pub analysis: Analysis,
+    /// Output requests.
+    pub output: OutputRequest,
+}
