@@ -1,0 +1,390 @@
+//! The geometrically exact two-node beam (Reissner; Simo 1985; Cardona & Géradin 1988).
+//!
+//! # Strains and resultants (physics.md §2, paper eqs. [5]–[9])
+//! Material strains `Γ = Λᵀ x₀' − E₁` and curvature `K̃ = Λᵀ Λ'`, resultants
+//! `N = C_N Γ`, `M = C_M K` with `C_N = diag(EA, kGA, kGA)`, `C_M = diag(GJ, EI₂, EI₃)`.
+//!
+//! # Interpolation (objective; Crisfield & Jelenić 1999)
+//! The element triads at the nodes are `Λᵢ = Rᵢ Λ₀` (`Λ₀`: the reference triad, axis 1
+//! along the bar). The triad along the element is `Λ(s) = Λ₁ exp(s ψ̃ / L)` with the
+//! *relative* rotation `ψ = log(Λ₁ᵀ Λ₂)`, so a rigid rotation of both nodes leaves `ψ`
+//! unchanged: the strains are objective and path-independent. With one-point (reduced)
+//! integration at the midpoint (against shear locking):
+//! `K = ψ / L`, `Γ = Λ_mᵀ (x₂ − x₁)/L − E₁`, `Λ_m = Λ₁ exp(ψ̃/2)`.
+//!
+//! # Internal forces (variation of `U = L(½ Γ·C_N Γ + ½ K·C_M K)`)
+//! With `a = Λ_mᵀ d`, `d = x₂ − x₁`, `g = N × a`, `p = M + ½ T(ψ/2)ᵀ g`:
+//! `f_x₂ = −f_x₁ = Λ_m N`, `f_θ₁ = exp(ψ̃/2) g − Q T(ψ)⁻ᵀ p`, `f_θ₂ = T(ψ)⁻ᵀ p`
+//! (`Q = Λ₁ᵀΛ₂`; moments in the element frame, turned to the node frame by `Λ₀`).
+//! The tangent stiffness is the exact derivative of these forces, obtained by forward-mode
+//! automatic differentiation (dual numbers, [`num_dual`]) — consistent by construction and
+//! checked against finite differences in the tests.
+//!
+//! # Inertia (paper eqs. [10]–[11])
+//! Consistent translational mass `ρAL/6 [2 1; 1 2]`, and rotary inertia lumped at the
+//! nodes, `J = (L/2) Λ₀ ρ diag(I₂+I₃, I₂, I₃) Λ₀ᵀ` in the node's material frame, with the
+//! gyroscopic force `J Ω̇ + Ω × J Ω`. Gravity: `ρAL g / 2` on each node.
+
+use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
+use crate::model::ElementId;
+use crate::rotation::{self, c, skew};
+use nalgebra::{Matrix3, RealField, SVector, Vector3};
+use num_dual::{Derivative, DualSVec64};
+
+/// Section and material properties of a beam, per unit length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeamProperties {
+    /// `(EA, kGA, kGA)`, N.
+    pub cn: Vector3<f64>,
+    /// `(GJ, EI₂, EI₃)`, N·m².
+    pub cm: Vector3<f64>,
+    /// Mass per unit length `ρA`, kg/m.
+    pub mass: f64,
+    /// Rotary inertia per unit length `ρ(I₂+I₃, I₂, I₃)`, kg·m.
+    pub inertia: Vector3<f64>,
+}
+
+/// A two-node geometrically exact beam.
+#[derive(Debug, Clone)]
+pub struct Beam {
+    id: ElementId,
+    nodes: [usize; 2],
+    length: f64,
+    /// Reference triad: columns = local axes 1, 2, 3 in the global frame.
+    lambda0: Matrix3<f64>,
+    props: BeamProperties,
+    /// Lumped rotary inertia at each node, node material frame.
+    j_node: Matrix3<f64>,
+}
+
+/// The default direction of local axis 2: global Y projected normal to the bar, or global Z
+/// when the bar is (nearly) parallel to Y.
+pub fn default_axis2(axis1: &Vector3<f64>) -> Vector3<f64> {
+    let y = Vector3::y();
+    if axis1.cross(&y).norm() > 1e-3 * axis1.norm() {
+        y
+    } else {
+        Vector3::z()
+    }
+}
+
+/// The reference triad of a bar from node 1 to node 2 with local axis 2 near `axis2`.
+pub fn reference_triad(x1: &Vector3<f64>, x2: &Vector3<f64>, axis2: &Vector3<f64>) -> Matrix3<f64> {
+    let t1 = (x2 - x1).normalize();
+    let t2 = (axis2 - t1 * t1.dot(axis2)).normalize();
+    let t3 = t1.cross(&t2);
+    Matrix3::from_columns(&[t1, t2, t3])
+}
+
+/// Kinematic results of the beam kernel.
+struct Kernel<S: RealField + Copy> {
+    /// `[f_x1, f_Θ1, f_x2, f_Θ2]` (node frames).
+    f: [Vector3<S>; 4],
+    gamma: Vector3<S>,
+    kappa: Vector3<S>,
+}
+
+impl Beam {
+    /// A beam between nodes (dense indices) at reference positions `x1`, `x2`.
+    pub fn new(
+        id: ElementId,
+        nodes: [usize; 2],
+        x1: &Vector3<f64>,
+        x2: &Vector3<f64>,
+        axis2: Option<Vector3<f64>>,
+        props: BeamProperties,
+    ) -> Self {
+        let d = x2 - x1;
+        let axis2 = axis2.unwrap_or_else(|| default_axis2(&d));
+        let lambda0 = reference_triad(x1, x2, &axis2);
+        let length = d.norm();
+        let j_node = lambda0 * Matrix3::from_diagonal(&(props.inertia * (0.5 * length))) * lambda0.transpose();
+        Beam {
+            id,
+            nodes,
+            length,
+            lambda0,
+            props,
+            j_node,
+        }
+    }
+
+    /// The reference length, m.
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// The strain kernel, generic in the scalar (f64 or dual numbers).
+    fn kernel<S: RealField + Copy>(
+        &self,
+        x1: Vector3<S>,
+        x2: Vector3<S>,
+        r1: Matrix3<S>,
+        r2: Matrix3<S>,
+    ) -> Kernel<S> {
+        let l0: Matrix3<S> = self.lambda0.map(c);
+        let inv_l = c::<S>(1.0 / self.length);
+        let lam1 = r1 * l0;
+        let lam2 = r2 * l0;
+        let q = lam1.transpose() * lam2;
+        let psi = rotation::log(&q);
+        let half = psi * c::<S>(0.5);
+        let e = rotation::exp(&half);
+        let lam_m = lam1 * e;
+        let d = x2 - x1;
+        let a = lam_m.transpose() * d;
+        let gamma = a * inv_l - Vector3::x();
+        let kappa = psi * inv_l;
+        let cn: Vector3<S> = self.props.cn.map(c);
+        let cm: Vector3<S> = self.props.cm.map(c);
+        let n = gamma.component_mul(&cn);
+        let m = kappa.component_mul(&cm);
+        let force = lam_m * n;
+        let g = n.cross(&a);
+        let p = m + rotation::tangent(&half).transpose() * g * c::<S>(0.5);
+        let qv = rotation::tangent_inv(&psi).transpose() * p;
+        let f1 = e * g - q * qv;
+        Kernel {
+            f: [-force, l0 * f1, force, l0 * qv],
+            gamma,
+            kappa,
+        }
+    }
+
+    /// Internal force vector `[f_x1, f_Θ1, f_x2, f_Θ2]` at the nodes' state.
+    pub fn internal_forces(&self, s1: &NodeState, s2: &NodeState) -> [Vector3<f64>; 4] {
+        self.kernel(s1.x, s2.x, s1.r, s2.r).f
+    }
+
+    /// Strains `Γ` and curvatures `K` at the midpoint.
+    pub fn strains(&self, s1: &NodeState, s2: &NodeState) -> (Vector3<f64>, Vector3<f64>) {
+        let k = self.kernel(s1.x, s2.x, s1.r, s2.r);
+        (k.gamma, k.kappa)
+    }
+
+    /// Internal forces and their exact derivative with respect to `[δx₁, δΘ₁, δx₂, δΘ₂]`,
+    /// by forward-mode AD with 12 dual directions.
+    fn internal_with_tangent(&self, s1: &NodeState, s2: &NodeState, out: &mut Local) {
+        type D = DualSVec64<12>;
+        let seed = |v: f64, k: usize| D::new(v, Derivative::derivative_generic(nalgebra::Const::<12>, nalgebra::U1, k));
+        let lift = |v: f64| D::new(v, Derivative::none());
+        let xs = |x: &Vector3<f64>, base: usize| Vector3::new(seed(x.x, base), seed(x.y, base + 1), seed(x.z, base + 2));
+        let rs = |r: &Matrix3<f64>, base: usize| {
+            // R (I + δΘ̃): exact to first order, which is all a dual number carries.
+            let dth = Vector3::new(seed(0.0, base), seed(0.0, base + 1), seed(0.0, base + 2));
+            let rr: Matrix3<D> = r.map(lift);
+            rr + rr * skew(&dth)
+        };
+        let k = self.kernel(xs(&s1.x, 0), xs(&s2.x, 6), rs(&s1.r, 3), rs(&s2.r, 9));
+        let n = out.n;
+        for (blk, v) in k.f.iter().enumerate() {
+            for comp in 0..3 {
+                let row = 3 * blk + comp;
+                out.res[row] += v[comp].re;
+                if let Some(eps) = &v[comp].eps.0 {
+                    let eps: &SVector<f64, 12> = eps;
+                    for col in 0..12 {
+                        out.tan[col * n + row] += eps[col];
+                    }
+                }
+            }
+        }
+    }
+
+    fn translational_mass(&self) -> f64 {
+        self.props.mass * self.length
+    }
+}
+
+impl Element for Beam {
+    fn id(&self) -> ElementId {
+        self.id
+    }
+
+    fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+
+    fn evaluate(&self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64], tangent: bool, out: &mut Local) {
+        let s1 = &nodes[self.nodes[0]];
+        let s2 = &nodes[self.nodes[1]];
+        if tangent {
+            self.internal_with_tangent(s1, s2, out);
+        } else {
+            let f = self.internal_forces(s1, s2);
+            for (k, v) in f.iter().enumerate() {
+                out.add_res(3 * k, v);
+            }
+        }
+        let m = self.translational_mass();
+        // Gravity (external: enters with a minus sign).
+        let wg = ctx.gravity * (0.5 * m);
+        out.add_res(tx(0), &-wg);
+        out.add_res(tx(1), &-wg);
+        if ctx.dynamic {
+            let (a1, a2) = (s1.a, s2.a);
+            out.add_res(tx(0), &((a1 * 2.0 + a2) * (m / 6.0)));
+            out.add_res(tx(1), &((a1 + a2 * 2.0) * (m / 6.0)));
+            for (k, s) in [s1, s2].into_iter().enumerate() {
+                let jw = self.j_node * s.w;
+                out.add_res(rx(k), &(self.j_node * s.wd + s.w.cross(&jw)));
+            }
+            if tangent {
+                let i = Matrix3::identity();
+                let m2 = i * (ctx.c_a * m / 3.0);
+                let m1 = i * (ctx.c_a * m / 6.0);
+                out.add_block(tx(0), tx(0), &m2);
+                out.add_block(tx(1), tx(1), &m2);
+                out.add_block(tx(0), tx(1), &m1);
+                out.add_block(tx(1), tx(0), &m1);
+                for (k, s) in [s1, s2].into_iter().enumerate() {
+                    let gyro = skew(&s.w) * self.j_node - skew(&(self.j_node * s.w));
+                    out.add_block(rx(k), rx(k), &(self.j_node * ctx.c_a + gyro * ctx.c_v));
+                }
+            }
+        }
+    }
+
+    fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {
+        let s1 = &nodes[self.nodes[0]];
+        let s2 = &nodes[self.nodes[1]];
+        let (gamma, kappa) = self.strains(s1, s2);
+        let strain = 0.5
+            * self.length
+            * (gamma.component_mul(&self.props.cn).dot(&gamma) + kappa.component_mul(&self.props.cm).dot(&kappa));
+        let m = self.translational_mass();
+        let kinetic = m / 6.0 * (s1.v.dot(&s1.v) + s1.v.dot(&s2.v) + s2.v.dot(&s2.v))
+            + 0.5 * s1.w.dot(&(self.j_node * s1.w))
+            + 0.5 * s2.w.dot(&(self.j_node * s2.w));
+        let gravity = -0.5 * m * gravity.dot(&(s1.x + s2.x));
+        Energies {
+            kinetic,
+            strain,
+            gravity,
+        }
+    }
+
+    fn output_header(&self) -> Vec<String> {
+        ["n1", "n2", "n3", "m1", "m2", "m3", "gamma1", "gamma2", "gamma3", "k1", "k2", "k3"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    fn output_row(&self, _ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) -> Vec<f64> {
+        let (g, k) = self.strains(&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
+        let n = g.component_mul(&self.props.cn);
+        let m = k.component_mul(&self.props.cm);
+        [n, m, g, k].iter().flat_map(|v| v.iter().copied()).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::elements::testing::*;
+
+    fn steel_props() -> BeamProperties {
+        let (e, g, a, i, j, rho) = (2.1e11, 2.1e11 / 2.6, 9e-4, 8.3e-8, 4.15e-8, 7800.0);
+        BeamProperties {
+            cn: Vector3::new(e * a, 5.0 / 6.0 * g * a, 5.0 / 6.0 * g * a),
+            cm: Vector3::new(g * j, e * i, e * i),
+            mass: rho * a,
+            inertia: Vector3::new(rho * 2.0 * i, rho * i, rho * i),
+        }
+    }
+
+    fn beam(x1: Vector3<f64>, x2: Vector3<f64>) -> Beam {
+        Beam::new(ElementId(1), [0, 1], &x1, &x2, None, steel_props())
+    }
+
+    #[test]
+    fn tangent_matches_finite_differences_static_and_dynamic() {
+        let x0 = [Vector3::new(0.1, 0.2, -0.1), Vector3::new(0.3, 0.25, 0.0)];
+        let b = beam(x0[0], x0[1]);
+        for seed in 1..6 {
+            // Large rotations (up to ~1.5 rad per node) and stretches of a few per cent.
+            let st = random_states(&x0, 0.01, 0.9, seed);
+            check_tangent(&b, &static_ctx(), &st, &[], 2e-7);
+            check_tangent(&b, &dyn_ctx(), &st, &[], 2e-7);
+        }
+    }
+
+    #[test]
+    fn internal_forces_are_the_gradient_of_the_strain_energy() {
+        let x0 = [Vector3::new(0.0, 0.1, 0.0), Vector3::new(0.2, 0.1, 0.1)];
+        let b = beam(x0[0], x0[1]);
+        let st = random_states(&x0, 0.003, 0.5, 11);
+        let f = b.internal_forces(&st[0], &st[1]);
+        let energy = |s: &[NodeState]| b.energies(s, &Vector3::zeros()).strain;
+        let eps = 1e-7;
+        let fmax = f.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for dir in 0..12 {
+            let mut e = Vector3::zeros();
+            e[dir % 3] = eps;
+            let (mut p, mut m) = (st.clone(), st.clone());
+            let k = dir / 6;
+            if dir % 6 < 3 {
+                p[k].x += e;
+                m[k].x -= e;
+            } else {
+                p[k].r *= rotation::exp(&e);
+                m[k].r *= rotation::exp(&-e);
+            }
+            let fd = (energy(&p) - energy(&m)) / (2.0 * eps);
+            let an = f[dir / 3][dir % 3];
+            assert!((fd - an).abs() < 1e-6 * fmax, "dof {dir}: {an} vs {fd}");
+        }
+    }
+
+    #[test]
+    fn rigid_motion_gives_zero_strain_and_zero_force() {
+        let x0 = [Vector3::new(0.0, 0.0, 0.0), Vector3::new(0.1, 0.05, 0.02)];
+        let b = beam(x0[0], x0[1]);
+        let rest = [NodeState::at_rest(x0[0]), NodeState::at_rest(x0[1])];
+        let q = rotation::exp(&Vector3::new(2.0, -1.0, 2.5)); // |Φ| ≈ 3.35 rad > π
+        let moved = rigidly_moved(&rest, &q, &Vector3::new(1.0, -2.0, 3.0));
+        let (g, k) = b.strains(&moved[0], &moved[1]);
+        assert!(g.norm() < 1e-14 && k.norm() < 1e-14, "{g} {k}");
+        let f = b.internal_forces(&moved[0], &moved[1]);
+        let fmax = f.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        // Relative to the force of a unit axial strain EA:
+        assert!(fmax < 1e-12 * steel_props().cn.x, "{fmax}");
+    }
+
+    #[test]
+    fn rigid_rotation_rotates_internal_forces() {
+        let x0 = [Vector3::new(0.0, 0.0, 0.0), Vector3::new(0.1, 0.0, 0.0)];
+        let b = beam(x0[0], x0[1]);
+        let st = random_states(&x0, 0.002, 0.3, 7);
+        let q = rotation::exp(&Vector3::new(-0.4, 1.3, 0.8));
+        let moved = rigidly_moved(&st, &q, &Vector3::new(0.3, 0.2, 0.1));
+        let f0 = b.internal_forces(&st[0], &st[1]);
+        let f1 = b.internal_forces(&moved[0], &moved[1]);
+        let scale = f0.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        // Forces are global (rotate with Q); moments are material (unchanged).
+        for k in [0, 2] {
+            assert!((f1[k] - q * f0[k]).norm() < 1e-9 * scale);
+        }
+        for k in [1, 3] {
+            assert!((f1[k] - f0[k]).norm() < 1e-9 * scale);
+        }
+    }
+
+    #[test]
+    fn pure_bending_curvature_is_exact() {
+        // Nodes rotated about local axis 3 by ±θ/2 around a circular arc: K₃ = θ/L.
+        let l = 0.2;
+        let b = beam(Vector3::zeros(), Vector3::new(l, 0.0, 0.0));
+        let theta = 0.3;
+        let r = l / theta; // arc radius, chord = 2 r sin(θ/2)
+        let s1 = NodeState::at_rest(Vector3::zeros());
+        let mut s2 = NodeState::at_rest(Vector3::new(r * theta.sin(), r * (1.0 - theta.cos()), 0.0));
+        s2.r = rotation::exp(&Vector3::new(0.0, 0.0, theta));
+        let (g, k) = b.strains(&s1, &s2);
+        assert!((k.z - theta / l).abs() < 1e-12);
+        // Midpoint-chord strain of an arc: chord/L·(1/cos 0)… axial strain = 2 sin(θ/2)/θ − 1.
+        assert!((g.x - (2.0 * (theta / 2.0).sin() / theta - 1.0)).abs() < 1e-12, "{g}");
+        assert!(g.y.abs() < 1e-12);
+    }
+}
