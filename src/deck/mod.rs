@@ -1,2 +1,360 @@
 //! The deck: text → raw cards (syntax) → [`crate::model::Model`] (meaning).
-//! (Being written; see `grammar.md`.)
+//!
+//! The language is documented in `grammar.md`. Three layers:
+//! 1. `lex` (nom): logical lines of tokens with byte spans (comments, `&` continuations,
+//!    numbers such as `1e-3`, `2.1E11`, `-.5`);
+//! 2. `cards`: tokens grouped into cards by section keyword;
+//! 3. `build`: cards → [`Model`], references resolved, defaults applied, values checked.
+//!
+//! Every error of a deck is reported at once ([`DeckErrors`]), each with its span, and
+//! [`parse_deck`] never panics. [`write_deck`] prints a model back in canonical form.
+
+mod build;
+mod cards;
+mod error;
+mod lex;
+mod write;
+
+pub use error::{DeckError, DeckErrorKind, DeckErrors};
+pub use write::write_deck;
+
+use crate::model::{Model, Span};
+use std::path::Path;
+
+/// Documentation of one keyword the parser accepts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KeywordDoc {
+    /// The keyword (upper case; the parser is case-insensitive).
+    pub name: &'static str,
+    /// Where it is used: the section (or card) it belongs to.
+    pub section: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+const fn kw(name: &'static str, section: &'static str, doc: &'static str) -> KeywordDoc {
+    KeywordDoc { name, section, doc }
+}
+
+/// Every keyword the parser accepts, with where it is used: the single source of truth
+/// for `grammar.md` (a test checks that each one is documented there). In debug builds the
+/// parser asserts that every keyword it matches is listed here.
+pub const KEYWORDS: &[KeywordDoc] = &[
+    // sections
+    kw(
+        "TITLE",
+        "deck",
+        "one-line section: the rest of the line is the deck's title",
+    ),
+    kw("MATERIALS", "deck", "section header: material cards follow"),
+    kw(
+        "SECTIONS",
+        "deck",
+        "section header: cross-section cards follow",
+    ),
+    kw("NODES", "deck", "section header: node cards follow"),
+    kw("ELEMENTS", "deck", "section header: element cards follow"),
+    kw(
+        "FUNCTIONS",
+        "deck",
+        "section header: time-function cards follow",
+    ),
+    kw(
+        "LOADS",
+        "deck",
+        "section header: GRAVITY, FORCE and MOMENT cards follow",
+    ),
+    kw("ANALYSIS", "deck", "one-line section: the analysis to run"),
+    kw(
+        "OUTPUT",
+        "deck",
+        "one-line section: what to write and where",
+    ),
+    kw("END", "deck", "end of the deck: nothing after it is read"),
+    // materials
+    kw("E", "MATERIALS", "Young's modulus, N/m² (> 0)"),
+    kw(
+        "NU",
+        "MATERIALS",
+        "Poisson's ratio (-1 < nu < 0.5); G = E/(2(1+nu))",
+    ),
+    kw("G", "MATERIALS", "shear modulus, N/m² (> 0), instead of NU"),
+    kw("RHO", "MATERIALS", "density, kg/m³ (>= 0)"),
+    kw(
+        "DAMPING",
+        "MATERIALS",
+        "stiffness-proportional damping coefficient, s (>= 0, default 0)",
+    ),
+    // sections
+    kw("A", "SECTIONS", "area, m² (> 0)"),
+    kw(
+        "I2",
+        "SECTIONS",
+        "second moment of area about local axis 2, m⁴",
+    ),
+    kw(
+        "I3",
+        "SECTIONS",
+        "second moment of area about local axis 3, m⁴",
+    ),
+    kw("J", "SECTIONS", "torsion constant, m⁴"),
+    kw(
+        "K",
+        "SECTIONS",
+        "shear correction factor (0 < k <= 1, default 5/6)",
+    ),
+    kw(
+        "RIGID",
+        "SECTIONS",
+        "rigid bar section (also an element type in ELEMENTS)",
+    ),
+    // nodes
+    kw(
+        "TO",
+        "NODES",
+        "generation: `<id1> TO <id2>` (also in ELEMENTS)",
+    ),
+    kw(
+        "LINE",
+        "NODES",
+        "nodes evenly spaced on a segment (also a CAME profile)",
+    ),
+    kw("FIX", "NODES", "fix degrees of freedom of a node"),
+    kw(
+        "ALL",
+        "NODES",
+        "all six degrees of freedom (also in OUTPUT: every entity)",
+    ),
+    kw("TRANS", "NODES", "the three translations"),
+    kw("ROT", "NODES", "the three rotations"),
+    kw("X", "NODES", "translation along global X"),
+    kw("Y", "NODES", "translation along global Y"),
+    kw("Z", "NODES", "translation along global Z"),
+    kw("RX", "NODES", "rotation about global X"),
+    kw("RY", "NODES", "rotation about global Y"),
+    kw("RZ", "NODES", "rotation about global Z"),
+    // elements
+    kw("BEAM", "ELEMENTS", "geometrically exact two-node beam"),
+    kw("MAT", "ELEMENTS", "material number of a BEAM"),
+    kw("SEC", "ELEMENTS", "section number of a BEAM"),
+    kw(
+        "AXIS2",
+        "ELEMENTS",
+        "BEAM: local axis 2 direction; UJOINT: axis on the second node",
+    ),
+    kw(
+        "MASS",
+        "ELEMENTS",
+        "point mass with optional rotary inertia",
+    ),
+    kw("M", "ELEMENTS", "mass of a MASS element, kg (>= 0)"),
+    kw(
+        "INERTIA",
+        "ELEMENTS",
+        "rotary inertia of a MASS, kg·m², global frame at t = 0",
+    ),
+    kw("HINGE", "ELEMENTS", "revolute joint"),
+    kw("AXIS", "ELEMENTS", "axis of a HINGE or PRISMATIC joint"),
+    kw("UJOINT", "ELEMENTS", "universal (Cardan) joint"),
+    kw("AXIS1", "ELEMENTS", "UJOINT axis on the first node"),
+    kw("SPHERICAL", "ELEMENTS", "spherical joint"),
+    kw("CLAMP", "ELEMENTS", "two nodes welded together"),
+    kw("PRISMATIC", "ELEMENTS", "prismatic (sliding) joint"),
+    kw("CAME", "ELEMENTS", "cam-follower contact element"),
+    kw("CAM", "ELEMENTS", "CAME: the cam's profile (first node)"),
+    kw(
+        "FOLLOWER",
+        "ELEMENTS",
+        "CAME: the follower's profile (second node)",
+    ),
+    kw("POINT", "ELEMENTS", "CAME profile: a point"),
+    kw(
+        "CIRCLE",
+        "ELEMENTS",
+        "CAME profile: a circle of given radius",
+    ),
+    kw(
+        "SPLINE",
+        "ELEMENTS",
+        "CAME profile: a cubic spline through points",
+    ),
+    kw(
+        "CLOSED",
+        "ELEMENTS",
+        "CAME SPLINE: a closed (periodic) curve",
+    ),
+    kw(
+        "ANGLE",
+        "ELEMENTS",
+        "CAME LINE: in-plane direction angle, degrees",
+    ),
+    kw(
+        "OFFSET",
+        "ELEMENTS",
+        "CAME profile: origin offset in the node frame, m",
+    ),
+    kw(
+        "PLANE",
+        "ELEMENTS",
+        "CAME profile: plane vectors e1 e2 in the node frame",
+    ),
+    kw(
+        "C",
+        "ELEMENTS",
+        "CAME: contact damping, N·s/m (>= 0, default 0)",
+    ),
+    kw(
+        "MU",
+        "ELEMENTS",
+        "CAME: Coulomb friction coefficient (>= 0, default 0)",
+    ),
+    kw(
+        "VREG",
+        "ELEMENTS",
+        "CAME: friction regularisation speed, m/s (> 0, default 1e-3)",
+    ),
+    kw(
+        "CLIP",
+        "ELEMENTS",
+        "CAME: clip the adhesive part of the contact force (ON/OFF)",
+    ),
+    kw("ON", "ELEMENTS", "CLIP ON"),
+    kw("OFF", "ELEMENTS", "CLIP OFF"),
+    kw(
+        "IMPACT_STEPS",
+        "ELEMENTS",
+        "CAME: minimum steps per impact (>= 1, default 10)",
+    ),
+    // functions
+    kw(
+        "TABLE",
+        "FUNCTIONS",
+        "piecewise-linear table of (t, f) pairs",
+    ),
+    kw("CONSTANT", "FUNCTIONS", "a constant function"),
+    // loads
+    kw("GRAVITY", "LOADS", "gravity acceleration vector, m/s²"),
+    kw("FORCE", "LOADS", "nodal force, N, global frame"),
+    kw("MOMENT", "LOADS", "nodal moment, N·m, global frame"),
+    kw(
+        "FUNCTION",
+        "LOADS",
+        "time function scaling a FORCE or MOMENT",
+    ),
+    // analysis
+    kw("DYNAMIC", "ANALYSIS", "implicit dynamics with HHT"),
+    kw("STATIC", "ANALYSIS", "static equilibrium with load steps"),
+    kw(
+        "ALPHA",
+        "ANALYSIS",
+        "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",
+    ),
+    kw("STEP", "ANALYSIS", "time step, s (> 0)"),
+    kw(
+        "MINSTEP",
+        "ANALYSIS",
+        "smallest step when cutting, s (default STEP/1024)",
+    ),
+    kw("MAXSTEP", "ANALYSIS", "largest step, s (default STEP)"),
+    kw("ADAPTIVE", "ANALYSIS", "adaptive time stepping"),
+    kw(
+        "TOLPOS",
+        "ANALYSIS",
+        "adaptive: local error tolerance on positions, m",
+    ),
+    kw(
+        "TOLROT",
+        "ANALYSIS",
+        "adaptive: local error tolerance on rotations, rad",
+    ),
+    kw(
+        "GROWTH",
+        "ANALYSIS",
+        "adaptive: largest step growth factor (>= 1, default 2)",
+    ),
+    kw(
+        "TOL",
+        "ANALYSIS",
+        "Newton residual tolerance (> 0, default 1e-8)",
+    ),
+    kw(
+        "TOLINC",
+        "ANALYSIS",
+        "Newton increment tolerance (> 0, default 1e-10)",
+    ),
+    kw(
+        "MAXIT",
+        "ANALYSIS",
+        "Newton iteration limit (>= 1, default 20)",
+    ),
+    kw(
+        "STEPS",
+        "ANALYSIS",
+        "number of static load steps (>= 1, default 1)",
+    ),
+    // output
+    kw("NONE", "OUTPUT", "no entity"),
+    kw(
+        "EVERY",
+        "OUTPUT",
+        "write a row every n steps (>= 1, default 1)",
+    ),
+    kw(
+        "DIR",
+        "OUTPUT",
+        "output directory (the command line's -o wins)",
+    ),
+    kw("VTK", "OUTPUT", "also write a ParaView series of VTK files"),
+];
+
+/// In debug builds, checks that the parser only matches keywords listed in [`KEYWORDS`].
+#[inline]
+fn debug_check_keyword(kw: &str) {
+    debug_assert!(
+        KEYWORDS.iter().any(|k| k.name == kw),
+        "keyword {kw} is accepted by the parser but missing from KEYWORDS"
+    );
+}
+
+/// Parses a deck's text into a validated model, or returns every error found.
+/// `file_name` is only used in diagnostics. Never panics.
+pub fn parse_deck(source: &str, file_name: &str) -> Result<Model, DeckErrors> {
+    let lines = lex::lex(source);
+    let empty = lines.is_empty();
+    let mut errors = Vec::new();
+    let cards = cards::cards(lines, &mut errors);
+    build::build_model(source, &cards, errors, empty)
+        .map_err(|errors| DeckErrors::new(source, file_name, errors))
+}
+
+/// Reads and parses a deck file. A missing or unreadable file, or one that is not UTF-8,
+/// gives a [`DeckErrors`] with a single error without span.
+pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
+    let name = path.display().to_string();
+    let file_error = |kind| DeckErrors::new("", &name, vec![DeckError { kind, span: None }]);
+    let bytes = std::fs::read(path).map_err(|e| {
+        file_error(DeckErrorKind::Io {
+            path: name.clone(),
+            reason: e.to_string(),
+        })
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        file_error(DeckErrorKind::NotUtf8 {
+            path: name.clone(),
+            offset: e.utf8_error().valid_up_to(),
+        })
+    })?;
+    parse_deck(&text, &name)
+}
+
+/// Sets every span in `model` to `Span::default()` (to compare models read from different
+/// texts).
+pub fn strip_spans(model: &mut Model) {
+    let zero = Span::default();
+    model.nodes.values_mut().for_each(|x| x.span = zero);
+    model.materials.values_mut().for_each(|x| x.span = zero);
+    model.sections.values_mut().for_each(|x| x.span = zero);
+    model.functions.values_mut().for_each(|x| x.span = zero);
+    model.elements.values_mut().for_each(|x| x.span = zero);
+    model.loads.iter_mut().for_each(|x| x.span = zero);
+}

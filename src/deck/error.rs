@@ -1,0 +1,427 @@
+//! Deck errors: one [`DeckError`] per mistake, all of a deck gathered in [`DeckErrors`],
+//! rendered like a compiler diagnostic by miette.
+
+use crate::model::Span;
+use miette::{Diagnostic, LabeledSpan, NamedSource, SourceCode};
+use std::fmt;
+
+/// What is wrong. Each message names the offending text and what was expected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DeckErrorKind {
+    /// The deck file could not be read.
+    #[error("cannot read deck file `{path}`: {reason}")]
+    Io {
+        /// The path as given.
+        path: String,
+        /// The operating system's reason.
+        reason: String,
+    },
+    /// The deck file is not UTF-8 text.
+    #[error("deck file `{path}` is not UTF-8 text (invalid byte at offset {offset})")]
+    NotUtf8 {
+        /// The path as given.
+        path: String,
+        /// Byte offset of the first invalid byte.
+        offset: usize,
+    },
+    /// Nothing but blanks and comments.
+    #[error("empty deck: no cards found (a deck needs at least an ANALYSIS card)")]
+    EmptyDeck,
+    /// No ANALYSIS card.
+    #[error("no ANALYSIS card: expected `ANALYSIS DYNAMIC ...` or `ANALYSIS STATIC ...`")]
+    MissingAnalysis,
+    /// A card that may appear once appears again.
+    #[error("second {keyword} card: only one is allowed (the first is on line {first_line})")]
+    RepeatedCard {
+        /// The card keyword (ANALYSIS, OUTPUT, TITLE, GRAVITY).
+        keyword: String,
+        /// Line of the first one.
+        first_line: usize,
+    },
+    /// A line starts with a word that is neither a section keyword nor a card keyword.
+    #[error("unknown keyword `{found}` at the start of a line: expected {expected}")]
+    UnknownSection {
+        /// The word.
+        found: String,
+        /// What is allowed there.
+        expected: String,
+    },
+    /// A data card before the first section keyword (or after a one-line section).
+    #[error("card `{found}` is outside a section: expected a section keyword first ({expected})")]
+    CardOutsideSection {
+        /// The first token of the card.
+        found: String,
+        /// What is allowed there.
+        expected: String,
+    },
+    /// A keyword not allowed at this place of a card.
+    #[error("unexpected `{found}` in {context}: expected {expected}")]
+    UnknownKeyword {
+        /// The token.
+        found: String,
+        /// The card.
+        context: String,
+        /// What is allowed there.
+        expected: String,
+    },
+    /// An unknown element type.
+    #[error(
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME"
+    )]
+    UnknownElementType {
+        /// The word.
+        found: String,
+    },
+    /// A token where a number is due is not a number.
+    #[error("expected {expected}, found `{found}` (not a number)")]
+    ExpectedNumber {
+        /// The field.
+        expected: String,
+        /// The token.
+        found: String,
+    },
+    /// A token where a whole number is due is not one.
+    #[error("expected {expected} (a whole number from 0 to 4294967295), found `{found}`")]
+    ExpectedInteger {
+        /// The field.
+        expected: String,
+        /// The token.
+        found: String,
+    },
+    /// A number too large to represent.
+    #[error("number `{found}` for {expected} is out of range (not a finite value)")]
+    NonFinite {
+        /// The field.
+        expected: String,
+        /// The token.
+        found: String,
+    },
+    /// The card ends before a required field.
+    #[error("missing {expected}: the card ends too early")]
+    MissingField {
+        /// The field.
+        expected: String,
+    },
+    /// Tokens left over at the end of a card.
+    #[error("unexpected `{found}` at the end of the {context} card: too many fields")]
+    ExtraToken {
+        /// The first extra token.
+        found: String,
+        /// The card.
+        context: String,
+    },
+    /// A required keyword is absent.
+    #[error("{context} needs {expected}")]
+    MissingKeyword {
+        /// The card.
+        context: String,
+        /// The missing keyword and its value.
+        expected: String,
+    },
+    /// A keyword given twice in one card.
+    #[error("`{keyword}` given twice in {context}")]
+    RepeatedKeyword {
+        /// The keyword.
+        keyword: String,
+        /// The card.
+        context: String,
+    },
+    /// Two keywords that exclude each other.
+    #[error("{first} and {second} cannot both be given in {context}: give one of them")]
+    Conflict {
+        /// The first keyword.
+        first: String,
+        /// The second keyword.
+        second: String,
+        /// The card.
+        context: String,
+    },
+    /// An entity number defined twice.
+    #[error("duplicate {what} number {id}: already defined on line {first_line}")]
+    Duplicate {
+        /// node, element, material, section or function.
+        what: &'static str,
+        /// The number.
+        id: u32,
+        /// Line of the first definition.
+        first_line: usize,
+    },
+    /// A reference to an entity never defined.
+    #[error("undefined {what} {id}: no {what} with this number is defined")]
+    Undefined {
+        /// node, element, material, section or function.
+        what: &'static str,
+        /// The number.
+        id: u32,
+    },
+    /// A generation `a TO b` with `b <= a` (or overflowing numbers).
+    #[error("bad generation `{first} TO {last}`: {reason}")]
+    BadGeneration {
+        /// First number.
+        first: u32,
+        /// Last number.
+        last: u32,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A BEAM whose two nodes are the same.
+    #[error("BEAM element {element} joins node {node} to itself: the two nodes must differ")]
+    BeamSameNode {
+        /// Element number.
+        element: u32,
+        /// Node number.
+        node: u32,
+    },
+    /// A BEAM of zero length.
+    #[error(
+        "BEAM element {element} has zero length: nodes {first} and {second} are at the same position"
+    )]
+    BeamZeroLength {
+        /// Element number.
+        element: u32,
+        /// First node.
+        first: u32,
+        /// Second node.
+        second: u32,
+    },
+    /// A zero or non-finite direction vector.
+    #[error("{what} must be a non-zero finite vector, found ({x}, {y}, {z})")]
+    BadAxis {
+        /// Which vector.
+        what: String,
+        /// Components as written.
+        x: String,
+        /// Components as written.
+        y: String,
+        /// Components as written.
+        z: String,
+    },
+    /// BEAM AXIS2 along the beam.
+    #[error(
+        "AXIS2 of BEAM element {element} is parallel to the beam: it must point across the beam"
+    )]
+    Axis2Parallel {
+        /// Element number.
+        element: u32,
+    },
+    /// PLANE vectors parallel.
+    #[error("PLANE vectors of a CAME profile are parallel: e1 and e2 must span a plane")]
+    PlaneParallel,
+    /// UJOINT axes not perpendicular.
+    #[error(
+        "UJOINT element {element}: AXIS1 and AXIS2 must be perpendicular (|a1·a2| = {dot:e} > 1e-6 |a1||a2|)"
+    )]
+    UJointNotPerpendicular {
+        /// Element number.
+        element: u32,
+        /// `|a1·a2| / (|a1||a2|)`.
+        dot: f64,
+    },
+    /// A value outside its admissible range.
+    #[error("{field} = {found} is out of range: expected {range}")]
+    OutOfRange {
+        /// The field.
+        field: String,
+        /// The value as written.
+        found: String,
+        /// The admissible range.
+        range: String,
+    },
+    /// A TABLE with an odd number of values.
+    #[error("TABLE values come in pairs `t f`: found {count} values (an odd number or none)")]
+    OddTable {
+        /// Number of values.
+        count: usize,
+    },
+    /// A TABLE with decreasing times.
+    #[error("TABLE times must be non-decreasing: t = {found} comes after t = {previous}")]
+    DecreasingTime {
+        /// The offending time as written.
+        found: String,
+        /// The previous time as written.
+        previous: String,
+    },
+}
+
+/// One mistake in a deck: what, and where (byte span in the source; `None` for file errors).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeckError {
+    /// What is wrong.
+    pub kind: DeckErrorKind,
+    /// Where, in bytes of the source text.
+    pub span: Option<Span>,
+}
+
+impl DeckError {
+    /// An error at `span`.
+    pub fn new(kind: DeckErrorKind, span: Span) -> Self {
+        DeckError {
+            kind,
+            span: Some(span),
+        }
+    }
+
+    /// The short text under the underlined span.
+    fn label(&self) -> &'static str {
+        use DeckErrorKind as K;
+        match &self.kind {
+            K::ExpectedNumber { .. } => "not a number",
+            K::ExpectedInteger { .. } => "not a whole number",
+            K::NonFinite { .. } => "too large",
+            K::MissingField { .. } | K::MissingKeyword { .. } => "card ends here",
+            K::ExtraToken { .. } => "extra field",
+            K::Duplicate { .. } | K::RepeatedCard { .. } | K::RepeatedKeyword { .. } => {
+                "defined again here"
+            }
+            K::Undefined { .. } => "undefined",
+            K::UnknownSection { .. }
+            | K::UnknownKeyword { .. }
+            | K::UnknownElementType { .. }
+            | K::CardOutsideSection { .. } => "unknown here",
+            K::OutOfRange { .. } | K::DecreasingTime { .. } => "out of range",
+            _ => "here",
+        }
+    }
+
+    fn labeled_span(&self) -> Option<LabeledSpan> {
+        self.span.map(|s| {
+            LabeledSpan::new(
+                Some(self.label().to_string()),
+                s.start,
+                s.end.saturating_sub(s.start),
+            )
+        })
+    }
+}
+
+impl fmt::Display for DeckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.kind.fmt(f)
+    }
+}
+
+impl std::error::Error for DeckError {}
+
+impl Diagnostic for DeckError {
+    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        Some(Box::new("mecano::deck"))
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
+        self.labeled_span()
+            .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
+    }
+}
+
+/// Every error found in one deck (never empty), with the deck's text and file name so that
+/// miette can render them: the first error is the main diagnostic, the others are
+/// [`Diagnostic::related`].
+#[derive(Debug)]
+pub struct DeckErrors {
+    source: NamedSource<String>,
+    errors: Vec<DeckError>,
+}
+
+impl DeckErrors {
+    /// Wraps `errors` (sorted by position, file errors first) with the deck's text.
+    pub fn new(source: &str, file_name: &str, mut errors: Vec<DeckError>) -> Self {
+        errors.sort_by_key(|e| e.span.map(|s| (s.start, s.end)));
+        DeckErrors {
+            source: NamedSource::new(file_name, source.to_string()),
+            errors,
+        }
+    }
+
+    /// The errors, in source order.
+    pub fn errors(&self) -> &[DeckError] {
+        &self.errors
+    }
+
+    /// The deck's file name as given.
+    pub fn file_name(&self) -> &str {
+        self.source.name()
+    }
+
+    /// Line and column (1-based; the column counts characters) of error `i`, or `None` when
+    /// it has no span or `i` is out of bounds.
+    pub fn line_col(&self, i: usize) -> Option<(usize, usize)> {
+        let span = self.errors.get(i)?.span?;
+        Some(line_col(self.source.inner(), span.start))
+    }
+}
+
+/// 1-based line and column (in characters) of byte `offset` of `text`.
+pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let mut offset = offset.min(text.len());
+    while !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |p| p + 1);
+    let col = before[line_start..].chars().count() + 1;
+    (line, col)
+}
+
+impl fmt::Display for DeckErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.errors.first() {
+            Some(e) => e.fmt(f),
+            None => write!(f, "invalid deck"),
+        }
+    }
+}
+
+impl std::error::Error for DeckErrors {}
+
+impl Diagnostic for DeckErrors {
+    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        Some(Box::new("mecano::deck"))
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        let n = self.errors.len();
+        (n > 1).then(|| {
+            Box::new(format!(
+                "{n} errors in `{}`; see grammar.md for the deck language",
+                self.source.name()
+            )) as Box<dyn fmt::Display>
+        })
+    }
+
+    fn source_code(&self) -> Option<&dyn SourceCode> {
+        Some(&self.source)
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
+        self.errors.first().and_then(|e| {
+            e.labeled_span()
+                .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
+        })
+    }
+
+    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn Diagnostic> + 'a>> {
+        if self.errors.len() < 2 {
+            return None;
+        }
+        Some(Box::new(
+            self.errors[1..].iter().map(|e| e as &dyn Diagnostic),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::line_col;
+
+    #[test]
+    fn line_col_counts_chars() {
+        let t = "ab\nçd\nx";
+        assert_eq!(line_col(t, 0), (1, 1));
+        assert_eq!(line_col(t, 3), (2, 1));
+        assert_eq!(line_col(t, 5), (2, 2));
+        assert_eq!(line_col(t, 7), (3, 1));
+        assert_eq!(line_col(t, 100), (3, 2));
+    }
+}

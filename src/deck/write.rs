@@ -1,0 +1,254 @@
+//! The canonical writer: [`Model`] → deck text that parses back to the same model.
+//!
+//! Floats are printed with `{:?}` (shortest representation that reads back exactly);
+//! generated nodes and elements are written one per line; every analysis setting is
+//! written explicitly.
+
+use crate::model::{Analysis, ElementKind, Function, Model, PlacedProfile, Profile, Selection};
+use nalgebra::{Matrix3, Vector3};
+use std::fmt::Write;
+
+fn v3(v: &Vector3<f64>) -> String {
+    format!("{:?} {:?} {:?}", v.x, v.y, v.z)
+}
+
+fn dofs(fixed: &[bool; 6]) -> String {
+    if fixed.iter().all(|f| *f) {
+        return "ALL".into();
+    }
+    const NAMES: [&str; 6] = ["X", "Y", "Z", "RX", "RY", "RZ"];
+    let names: Vec<&str> = NAMES
+        .iter()
+        .zip(fixed)
+        .filter(|(_, f)| **f)
+        .map(|(n, _)| *n)
+        .collect();
+    names.join(" ")
+}
+
+fn profile(p: &PlacedProfile) -> String {
+    let mut s = match &p.profile {
+        Profile::Line => "LINE".to_string(),
+        Profile::Point => "POINT".to_string(),
+        Profile::Circle { radius } => format!("CIRCLE {radius:?}"),
+        Profile::Spline { points, closed } => {
+            let mut s = String::from("SPLINE");
+            if *closed {
+                s.push_str(" CLOSED");
+            }
+            let _ = write!(s, " {}", points.len());
+            for [x, y] in points {
+                let _ = write!(s, " {x:?} {y:?}");
+            }
+            s
+        }
+    };
+    if p.offset != Vector3::zeros() {
+        let _ = write!(s, " OFFSET {}", v3(&p.offset));
+    }
+    if p.frame != Matrix3::identity() {
+        let e1: Vector3<f64> = p.frame.column(0).into();
+        let e2: Vector3<f64> = p.frame.column(1).into();
+        let _ = write!(s, " PLANE {} {}", v3(&e1), v3(&e2));
+    }
+    s
+}
+
+fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
+    match s {
+        Selection::All => "ALL".into(),
+        Selection::None => "NONE".into(),
+        Selection::List(v) => {
+            let n: Vec<String> = v.iter().map(|x| num(x).to_string()).collect();
+            n.join(" ")
+        }
+    }
+}
+
+/// Writes `model` as a deck in canonical form: `parse_deck(&write_deck(&m), _)` gives `m`
+/// back (spans aside) for every model `parse_deck` can produce.
+pub fn write_deck(model: &Model) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "TITLE {}", model.title);
+    if !model.materials.is_empty() {
+        s.push_str("MATERIALS\n");
+        for m in model.materials.values() {
+            let _ = write!(
+                s,
+                "  {} E {:?} G {:?} RHO {:?}",
+                m.id.0, m.young, m.shear, m.density
+            );
+            if m.damping != 0.0 {
+                let _ = write!(s, " DAMPING {:?}", m.damping);
+            }
+            s.push('\n');
+        }
+    }
+    if !model.sections.is_empty() {
+        s.push_str("SECTIONS\n");
+        for x in model.sections.values() {
+            if x.rigid {
+                let _ = writeln!(
+                    s,
+                    "  {} RIGID A {:?} I2 {:?} I3 {:?} J {:?}",
+                    x.id.0, x.area, x.i2, x.i3, x.torsion
+                );
+            } else {
+                let _ = writeln!(
+                    s,
+                    "  {} A {:?} I2 {:?} I3 {:?} J {:?} K {:?}",
+                    x.id.0, x.area, x.i2, x.i3, x.torsion, x.shear_factor
+                );
+            }
+        }
+    }
+    if !model.nodes.is_empty() {
+        s.push_str("NODES\n");
+        for n in model.nodes.values() {
+            let _ = write!(s, "  {} {}", n.id.0, v3(&n.position));
+            if n.fixed.iter().any(|f| *f) {
+                let _ = write!(s, " FIX {}", dofs(&n.fixed));
+            }
+            s.push('\n');
+        }
+    }
+    if !model.functions.is_empty() {
+        s.push_str("FUNCTIONS\n");
+        for f in model.functions.values() {
+            match &f.function {
+                Function::Constant(v) => {
+                    let _ = writeln!(s, "  {} CONSTANT {v:?}", f.id.0);
+                }
+                Function::Table(pts) => {
+                    let _ = write!(s, "  {} TABLE", f.id.0);
+                    for (t, v) in pts {
+                        let _ = write!(s, " {t:?} {v:?}");
+                    }
+                    s.push('\n');
+                }
+            }
+        }
+    }
+    if !model.elements.is_empty() {
+        s.push_str("ELEMENTS\n");
+        for e in model.elements.values() {
+            let nodes: Vec<String> = e.nodes.iter().map(|n| n.0.to_string()).collect();
+            let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
+            match &e.kind {
+                ElementKind::Beam {
+                    material,
+                    section,
+                    axis2,
+                } => {
+                    let _ = write!(s, " MAT {} SEC {}", material.0, section.0);
+                    if let Some(a) = axis2 {
+                        let _ = write!(s, " AXIS2 {}", v3(a));
+                    }
+                }
+                ElementKind::Mass { mass, inertia } => {
+                    let _ = write!(s, " M {mass:?}");
+                    if *inertia != Matrix3::zeros() {
+                        let i = inertia;
+                        let _ = write!(
+                            s,
+                            " INERTIA {:?} {:?} {:?}",
+                            i[(0, 0)],
+                            i[(1, 1)],
+                            i[(2, 2)]
+                        );
+                        if i[(0, 1)] != 0.0 || i[(0, 2)] != 0.0 || i[(1, 2)] != 0.0 {
+                            let _ = write!(s, " {:?} {:?} {:?}", i[(0, 1)], i[(0, 2)], i[(1, 2)]);
+                        }
+                    }
+                }
+                ElementKind::Hinge { axis } | ElementKind::Prismatic { axis } => {
+                    let _ = write!(s, " AXIS {}", v3(axis));
+                }
+                ElementKind::UJoint { axis1, axis2 } => {
+                    let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
+                }
+                ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
+                ElementKind::Came(c) => {
+                    let _ = write!(
+                        s,
+                        " CAM {} FOLLOWER {} K {:?} C {:?} MU {:?} VREG {:?} CLIP {} IMPACT_STEPS {}",
+                        profile(&c.cam),
+                        profile(&c.follower),
+                        c.stiffness,
+                        c.damping,
+                        c.friction,
+                        c.friction_speed,
+                        if c.clip_tension { "ON" } else { "OFF" },
+                        c.impact_steps
+                    );
+                }
+            }
+            s.push('\n');
+        }
+    }
+    if model.gravity.is_some() || !model.loads.is_empty() {
+        s.push_str("LOADS\n");
+        if let Some(g) = &model.gravity {
+            let _ = writeln!(s, "  GRAVITY {}", v3(g));
+        }
+        for l in &model.loads {
+            let kw = if l.moment { "MOMENT" } else { "FORCE" };
+            let _ = write!(s, "  {kw} {} {}", l.node.0, v3(&l.value));
+            if let Some(f) = l.function {
+                let _ = write!(s, " FUNCTION {}", f.0);
+            }
+            s.push('\n');
+        }
+    }
+    match &model.analysis {
+        Analysis::Dynamic {
+            alpha,
+            step,
+            end,
+            min_step,
+            max_step,
+            adaptive,
+            newton,
+        } => {
+            let _ = write!(
+                s,
+                "ANALYSIS DYNAMIC ALPHA {alpha:?} STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
+            );
+            if let Some(a) = adaptive {
+                let _ = write!(
+                    s,
+                    " ADAPTIVE TOLPOS {:?} TOLROT {:?} GROWTH {:?}",
+                    a.tol_position, a.tol_rotation, a.max_growth
+                );
+            }
+            let _ = writeln!(
+                s,
+                " &\n  TOL {:?} TOLINC {:?} MAXIT {}",
+                newton.tol_residual, newton.tol_increment, newton.max_iterations
+            );
+        }
+        Analysis::Static { steps, newton } => {
+            let _ = writeln!(
+                s,
+                "ANALYSIS STATIC STEPS {steps} TOL {:?} TOLINC {:?} MAXIT {}",
+                newton.tol_residual, newton.tol_increment, newton.max_iterations
+            );
+        }
+    }
+    let o = &model.output;
+    let _ = write!(
+        s,
+        "OUTPUT NODES {} ELEMENTS {} EVERY {}",
+        selection(&o.nodes, |n| n.0),
+        selection(&o.elements, |e| e.0),
+        o.every
+    );
+    if let Some(d) = &o.dir {
+        let _ = write!(s, " DIR {d}");
+    }
+    if o.vtk {
+        s.push_str(" VTK");
+    }
+    s.push_str("\nEND\n");
+    s
+}
