@@ -703,6 +703,9 @@ impl<'s> Builder<'s> {
                         c.end_span(),
                     )
                 };
+                // Report the first mistake in reading order: nodes come before MAT.
+                self.node_ref(n1.0, n1.1)?;
+                self.node_ref(n2.0, n2.1)?;
                 let (mat, ms) = mat.ok_or_else(|| miss("MAT <material number>"))?;
                 let (sec, ss) = sec.ok_or_else(|| miss("SEC <section number>"))?;
                 if !self.materials.contains_key(&MaterialId(mat)) {
