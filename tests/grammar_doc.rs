@@ -1,0 +1,121 @@
+//! `grammar.md` documents every keyword the parser accepts, documents nothing the parser
+//! does not accept, and its examples are valid decks.
+
+use mecano::deck::{KEYWORDS, parse_deck};
+use std::collections::BTreeSet;
+
+fn grammar() -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("grammar.md");
+    std::fs::read_to_string(path).expect("grammar.md exists")
+}
+
+/// Contents of the `inline code` spans of `text` (fenced blocks excluded).
+fn code_spans(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_fence = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            in_fence = !in_fence;
+            continue;
+        }
+        if in_fence {
+            continue;
+        }
+        let parts: Vec<&str> = line.split('`').collect();
+        out.extend(parts.iter().skip(1).step_by(2).map(|s| s.to_string()));
+    }
+    out
+}
+
+fn is_keyword_like(w: &str) -> bool {
+    let mut c = w.chars();
+    c.next().is_some_and(|f| f.is_ascii_uppercase())
+        && c.all(|ch| ch.is_ascii_uppercase() || ch.is_ascii_digit() || ch == '_')
+}
+
+#[test]
+fn every_keyword_is_documented() {
+    let spans: BTreeSet<String> = code_spans(&grammar()).into_iter().collect();
+    let missing: Vec<&str> = KEYWORDS
+        .iter()
+        .map(|k| k.name)
+        .filter(|name| !spans.contains(*name))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "keywords accepted by the parser but not documented in grammar.md (as `KEYWORD`): {missing:?}"
+    );
+}
+
+#[test]
+fn keywords_have_docs_and_known_sections() {
+    let sections = [
+        "deck",
+        "MATERIALS",
+        "SECTIONS",
+        "NODES",
+        "ELEMENTS",
+        "FUNCTIONS",
+        "LOADS",
+        "ANALYSIS",
+        "OUTPUT",
+    ];
+    let mut seen = BTreeSet::new();
+    for k in KEYWORDS {
+        assert!(is_keyword_like(k.name), "{k:?}");
+        assert!(!k.doc.is_empty(), "{k:?}");
+        assert!(sections.contains(&k.section), "{k:?}");
+        assert!(seen.insert(k.name), "keyword {} listed twice", k.name);
+    }
+}
+
+#[test]
+fn the_reference_documents_only_accepted_keywords() {
+    let text = grammar();
+    let start = text
+        .find("## Keyword reference")
+        .expect("a keyword reference section");
+    let end = text[start..]
+        .find("\n## Errors")
+        .map_or(text.len(), |e| start + e);
+    let known: BTreeSet<&str> = KEYWORDS.iter().map(|k| k.name).collect();
+    let unknown: BTreeSet<String> = code_spans(&text[start..end])
+        .iter()
+        .flat_map(|s| s.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+        .filter(|w| is_keyword_like(w) && !known.contains(w.as_str()))
+        .collect();
+    assert!(
+        unknown.is_empty(),
+        "documented in grammar.md but not accepted by the parser: {unknown:?}"
+    );
+}
+
+#[test]
+fn the_examples_parse() {
+    let text = grammar();
+    let start = text
+        .find("## Full example")
+        .expect("a full example section");
+    let mut blocks = Vec::new();
+    let mut cur: Option<String> = None;
+    for line in text[start..].lines() {
+        if line.starts_with("```") {
+            match cur.take() {
+                Some(b) => blocks.push(b),
+                None => cur = Some(String::new()),
+            }
+        } else if let Some(b) = cur.as_mut() {
+            b.push_str(line);
+            b.push('\n');
+        }
+    }
+    assert!(blocks.len() >= 2, "expected the examples");
+    for b in &blocks {
+        if let Err(e) = parse_deck(b, "grammar.md example") {
+            panic!("{:?}", miette::Report::new(e));
+        }
+    }
+    // The first example is the scene of decks/pendulum.dat.
+    let m = parse_deck(&blocks[0], "example").expect("parses");
+    assert_eq!((m.nodes.len(), m.elements.len()), (24, 25));
+}
