@@ -5,6 +5,7 @@
 //! Newton, sparse linear algebra) → [`output`] (per-node CSV histories, `summary.json`).
 #![warn(missing_docs)]
 
+pub mod app;
 pub mod deck;
 pub mod elements;
 pub mod model;

@@ -18,8 +18,70 @@
 pub mod beam;
 pub mod mass;
 
-use crate::model::ElementId;
+use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
+
+/// Errors while turning model elements into solver elements.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BuildError {
+    /// Element types this build of the solver does not support: it refuses to run rather
+    /// than ignore them.
+    #[error("the solver does not support {0} yet; remove them or wait for the release that does")]
+    Unsupported(String),
+    /// Element data the solver cannot use (e.g. a beam of zero length).
+    #[error("{element}: {message}")]
+    Invalid {
+        /// The element.
+        element: ElementId,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Builds the solver's elements from a validated model, in model order.
+pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
+    let idx = |id| model.nodes.get_index_of(id).expect("validated model: nodes exist");
+    let mut out: Vec<Box<dyn Element>> = Vec::with_capacity(model.elements.len());
+    let mut unsupported = Vec::new();
+    for el in model.elements.values() {
+        match &el.kind {
+            ElementKind::Beam { material, section, axis2 } => {
+                let mat = &model.materials[material];
+                let sec = &model.sections[section];
+                let (a, b) = (idx(&el.nodes[0]), idx(&el.nodes[1]));
+                let (x1, x2) = (model.nodes[a].position, model.nodes[b].position);
+                if sec.rigid {
+                    unsupported.push(format!("{} (BEAM with a RIGID section)", el.id));
+                    continue;
+                }
+                if mat.damping > 0.0 {
+                    unsupported.push(format!("{} (material DAMPING)", el.id));
+                    continue;
+                }
+                let props = beam::BeamProperties {
+                    cn: Vector3::new(
+                        mat.young * sec.area,
+                        sec.shear_factor * mat.shear * sec.area,
+                        sec.shear_factor * mat.shear * sec.area,
+                    ),
+                    cm: Vector3::new(mat.shear * sec.torsion, mat.young * sec.i2, mat.young * sec.i3),
+                    mass: mat.density * sec.area,
+                    inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
+                };
+                out.push(Box::new(beam::Beam::new(el.id, [a, b], &x1, &x2, *axis2, props)));
+            }
+            ElementKind::Mass { mass, inertia } => {
+                out.push(Box::new(mass::PointMass::new(el.id, idx(&el.nodes[0]), *mass, *inertia)));
+            }
+            other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
+        }
+    }
+    if unsupported.is_empty() {
+        Ok(out)
+    } else {
+        Err(BuildError::Unsupported(unsupported.join(", ")))
+    }
+}
 
 /// Kinematic state of one node.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -200,6 +262,11 @@ pub trait Element: Send + Sync {
     /// without constraints.
     fn constraint_violation(&self, _nodes: &[NodeState]) -> f64 {
         0.0
+    }
+
+    /// Element facts for `summary.json` (e.g. number of impacts of a contact).
+    fn summary(&self) -> Option<serde_json::Value> {
+        None
     }
 
     /// Dissipated power of element damping (contact dashpot, material damping), W, at the

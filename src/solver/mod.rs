@@ -1,1 +1,219 @@
-//! Time integration.
+//! Time integration (HHT), static load stepping, Newton–Raphson and sparse linear algebra.
+//!
+//! [`run`] drives an analysis of a [`Model`] and reports every accepted state to an
+//! [`Observer`] (the output writers), so a run that stops early has already delivered
+//! what it computed.
+
+pub mod integrator;
+pub mod linear;
+pub mod system;
+
+pub use integrator::{HhtParams, Integrator, StepInfo};
+pub use system::{BuildError, System};
+
+use crate::model::{Analysis, Model};
+use std::time::Instant;
+
+/// Counters of a run (written to `summary.json`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Newton iterations of accepted steps.
+    pub newton_iterations: u64,
+    /// Numeric LU factorisations (accepted and rejected attempts).
+    pub factorizations: u64,
+    /// Rejected (cut) step attempts.
+    pub rejected_steps: u64,
+    /// Smallest step used, s.
+    pub min_step: f64,
+    /// Largest step used, s.
+    pub max_step: f64,
+    /// CPU (wall) seconds of the integration.
+    pub cpu_seconds: f64,
+    /// Largest constraint violation seen at an accepted step.
+    pub max_constraint_violation: f64,
+}
+
+/// Why a step failed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FailureReason {
+    /// Newton did not converge within the iteration limit.
+    NoConvergence(u32),
+    /// A residual or an increment became NaN or infinite.
+    NotFinite,
+    /// The iteration matrix could not be factored.
+    Singular(String),
+}
+
+/// The diagnosis of a failed run: where, when and how badly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    /// Time of the last accepted state, s.
+    pub time: f64,
+    /// Step size of the failed attempt, s.
+    pub step: f64,
+    /// What went wrong.
+    pub reason: FailureReason,
+    /// Relative residual at each Newton iteration of the last attempt.
+    pub residual_history: Vec<f64>,
+    /// The equation with the largest residual, e.g. `node 23 uy`.
+    pub worst: String,
+    /// Its residual, N or N·m.
+    pub worst_value: f64,
+    /// Reference force used to scale the residual.
+    pub reference_force: f64,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = match &self.reason {
+            FailureReason::NoConvergence(n) => format!("Newton did not converge in {n} iterations"),
+            FailureReason::NotFinite => "the solution became non-finite (NaN or infinity)".to_string(),
+            FailureReason::Singular(s) => s.clone(),
+        };
+        writeln!(f, "{why} at t = {:.6e} s with step h = {:.3e} s", self.time, self.step)?;
+        let hist: Vec<String> = self.residual_history.iter().map(|r| format!("{r:.2e}")).collect();
+        writeln!(f, "  relative residual by iteration: [{}]", hist.join(", "))?;
+        write!(
+            f,
+            "  largest residual: {} = {:.3e} (reference force {:.3e})",
+            self.worst, self.worst_value, self.reference_force
+        )
+    }
+}
+
+/// A snapshot of an accepted state, handed to observers.
+pub struct Snapshot<'a> {
+    /// The integrator (state, system, counters).
+    pub integ: &'a Integrator,
+    /// Step index (0 = initial state).
+    pub step: u64,
+    /// Step size that led here (0 at the start).
+    pub h: f64,
+}
+
+/// Receives the states of a run as they are accepted.
+pub trait Observer {
+    /// Called with the initial state and each accepted state. An error stops the run.
+    fn state(&mut self, snap: &Snapshot) -> std::io::Result<()>;
+    /// Progress: time reached and end time.
+    fn progress(&mut self, _t: f64, _end: f64, _stats: &Stats) {}
+}
+
+/// Result of a run.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// Counters.
+    pub stats: Stats,
+    /// Time (or load factor) reached.
+    pub time: f64,
+    /// The diagnosis if the run stopped before its end.
+    pub failure: Option<Failure>,
+}
+
+/// Errors that prevent a run from starting or continuing.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The system could not be built.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// An observer failed (e.g. disk full).
+    #[error("writing output failed: {0}")]
+    Output(#[from] std::io::Error),
+}
+
+/// Builds the integrator for a model (initial velocities applied, not yet initialised).
+pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
+    let sys = System::new(model)?;
+    Ok(match &model.analysis {
+        Analysis::Dynamic { alpha, newton, .. } => Integrator::new(sys, newton.clone(), *alpha, true),
+        Analysis::Static { newton, .. } => Integrator::new(sys, newton.clone(), 0.0, false),
+    })
+}
+
+/// Runs the model's analysis, reporting every accepted state to `obs`.
+pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<RunReport, RunError> {
+    let mut integ = prepare(model)?;
+    run_prepared(model, &mut integ, obs)
+}
+
+/// Runs an already prepared integrator (lets callers set initial conditions first).
+pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observer) -> Result<RunReport, RunError> {
+    let start = Instant::now();
+    let (end, h0, hmin, hmax) = match &model.analysis {
+        Analysis::Dynamic {
+            step, end, min_step, max_step, ..
+        } => (*end, *step, *min_step, *max_step),
+        Analysis::Static { steps, .. } => {
+            let h = 1.0 / f64::from((*steps).max(1));
+            (1.0, h, h / 1024.0, h)
+        }
+    };
+    let _ = hmax;
+    integ.stats.min_step = f64::INFINITY;
+    let mut failure = integ.initialize().err();
+    if failure.is_none() {
+        obs.state(&Snapshot { integ, step: 0, h: 0.0 })?;
+    }
+    // Breakpoints of load functions: steps land on them rather than straddle a kink.
+    let mut breaks: Vec<f64> = integ
+        .sys
+        .loads
+        .iter()
+        .filter_map(|l| l.function.as_ref())
+        .flat_map(|f| f.breakpoints())
+        .filter(|t| *t > 0.0 && *t < end)
+        .collect();
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    let mut h = h0;
+    let mut good = 0u32;
+    let eps = 1e-9 * h0;
+    while failure.is_none() && integ.t < end - eps {
+        let t = integ.t;
+        let mut h_try = h.min(end - t);
+        if let Some(b) = breaks.iter().find(|b| **b > t + eps) {
+            if t + h_try > *b - eps {
+                h_try = *b - t;
+            }
+        }
+        match integ.try_step(h_try) {
+            Ok(_) => {
+                integ.stats.min_step = integ.stats.min_step.min(h_try);
+                integ.stats.max_step = integ.stats.max_step.max(h_try);
+                let v = integ.constraint_violation();
+                integ.stats.max_constraint_violation = integ.stats.max_constraint_violation.max(v);
+                integ.stats.cpu_seconds = start.elapsed().as_secs_f64();
+                obs.state(&Snapshot {
+                    integ,
+                    step: integ.stats.steps,
+                    h: h_try,
+                })?;
+                obs.progress(integ.t, end, &integ.stats);
+                good += 1;
+                if h < h0 && good >= 4 {
+                    h = (2.0 * h).min(h0);
+                    good = 0;
+                }
+            }
+            Err(f) => {
+                integ.stats.rejected_steps += 1;
+                good = 0;
+                h = h_try / 2.0;
+                if h < hmin * (1.0 - 1e-12) {
+                    failure = Some(f);
+                }
+            }
+        }
+    }
+    if integ.stats.min_step == f64::INFINITY {
+        integ.stats.min_step = 0.0;
+    }
+    integ.stats.cpu_seconds = start.elapsed().as_secs_f64();
+    Ok(RunReport {
+        stats: integ.stats,
+        time: integ.t,
+        failure,
+    })
+}

@@ -1,0 +1,363 @@
+//! The assembled system: dense node numbering, degrees of freedom, sparsity pattern and
+//! the assembly of element contributions into the global residual and iteration matrix.
+
+use super::linear::{LinearError, SparseSystem};
+use crate::elements::{self, Element, EvalContext, Local, NodeState};
+use crate::model::{Function, Model, NodeId};
+use crate::rotation::skew;
+use nalgebra::Vector3;
+
+/// Marks a fixed degree of freedom (no equation).
+pub const FIXED: usize = usize::MAX;
+const NONE: u32 = u32::MAX;
+
+/// What a global equation is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DofOwner {
+    /// Component `comp` (0–2 translation x, y, z; 3–5 rotation) of dense node `node`.
+    Node {
+        /// Dense node index.
+        node: usize,
+        /// Component 0..6.
+        comp: usize,
+    },
+    /// Multiplier `k` of dense element `element`.
+    Multiplier {
+        /// Dense element index.
+        element: usize,
+        /// Multiplier number within the element.
+        k: usize,
+    },
+}
+
+/// A nodal load resolved to dense indices.
+#[derive(Debug, Clone)]
+pub struct AppliedLoad {
+    /// Dense node index.
+    pub node: usize,
+    /// Moment (true) or force.
+    pub moment: bool,
+    /// Global components at `f = 1`.
+    pub value: Vector3<f64>,
+    /// Time function (`None` = 1).
+    pub function: Option<Function>,
+}
+
+impl AppliedLoad {
+    /// Global load vector at time `t`.
+    pub fn at(&self, t: f64) -> Vector3<f64> {
+        self.value * self.function.as_ref().map_or(1.0, |f| f.eval(t))
+    }
+}
+
+/// Errors while building the system.
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    /// An element could not be built.
+    #[error(transparent)]
+    Elements(#[from] elements::BuildError),
+    /// The linear solver could not analyse the pattern.
+    #[error(transparent)]
+    Linear(#[from] LinearError),
+}
+
+/// The discretised model ready for time integration.
+pub struct System {
+    /// The user's node numbers, dense order.
+    pub node_ids: Vec<NodeId>,
+    /// Reference positions.
+    pub x0: Vec<Vector3<f64>>,
+    /// Elements, dense order (model order).
+    pub elements: Vec<Box<dyn Element>>,
+    /// Global equation of each node dof, or [`FIXED`].
+    pub node_dofs: Vec<[usize; 6]>,
+    /// First global equation of each element's multipliers.
+    pub mult_offset: Vec<usize>,
+    /// Number of nodal (non-multiplier) equations; they come first.
+    pub n_node_eq: usize,
+    /// Owner of each global equation.
+    pub owners: Vec<DofOwner>,
+    /// Applied loads.
+    pub loads: Vec<AppliedLoad>,
+    /// Gravity (zero when none).
+    pub gravity: Vector3<f64>,
+    /// Iteration matrix with its LU.
+    pub matrix: SparseSystem,
+    /// Global residual.
+    pub rhs: Vec<f64>,
+    locals: Vec<Local>,
+    rows: Vec<Vec<u32>>,
+    maps: Vec<Vec<u32>>,
+    moment_blocks: Vec<[u32; 9]>,
+    /// Largest |load| or weight: the model's reference force, N.
+    pub ref_force: f64,
+    /// Size of the model's bounding box (≥ the longest element), m.
+    pub ref_length: f64,
+}
+
+/// Magnitudes seen during an assembly (for convergence tests).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct AssemblyInfo {
+    /// Largest absolute nodal contribution of any element (force scale).
+    pub force_scale: f64,
+}
+
+impl System {
+    /// Builds the system of a validated model.
+    pub fn new(model: &Model) -> Result<Self, BuildError> {
+        let node_ids: Vec<NodeId> = model.nodes.keys().copied().collect();
+        let x0: Vec<Vector3<f64>> = model.nodes.values().map(|n| n.position).collect();
+        let elements = elements::build(model)?;
+        let mut node_dofs = Vec::with_capacity(node_ids.len());
+        let mut owners = Vec::new();
+        for (i, node) in model.nodes.values().enumerate() {
+            let mut d = [FIXED; 6];
+            for (comp, slot) in d.iter_mut().enumerate() {
+                if !node.fixed[comp] {
+                    *slot = owners.len();
+                    owners.push(DofOwner::Node { node: i, comp });
+                }
+            }
+            node_dofs.push(d);
+        }
+        let n_node_eq = owners.len();
+        let mut mult_offset = Vec::with_capacity(elements.len());
+        for (e, el) in elements.iter().enumerate() {
+            mult_offset.push(owners.len());
+            for k in 0..el.multipliers() {
+                owners.push(DofOwner::Multiplier { element: e, k });
+            }
+        }
+        let n = owners.len();
+        // Local → global rows.
+        let rows: Vec<Vec<u32>> = elements
+            .iter()
+            .enumerate()
+            .map(|(e, el)| {
+                let mut r = Vec::new();
+                for &node in el.nodes() {
+                    for comp in 0..6 {
+                        let d = node_dofs[node][comp];
+                        r.push(if d == FIXED { NONE } else { d as u32 });
+                    }
+                }
+                for k in 0..el.multipliers() {
+                    r.push((mult_offset[e] + k) as u32);
+                }
+                r
+            })
+            .collect();
+        // Pattern: element blocks, node diagonal blocks (moment loads), and the diagonal.
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for r in &rows {
+            for &j in r.iter().filter(|j| **j != NONE) {
+                for &i in r.iter().filter(|i| **i != NONE) {
+                    columns[j as usize].push(i as usize);
+                }
+            }
+        }
+        for d in &node_dofs {
+            for a in 3..6 {
+                for b in 3..6 {
+                    if d[a] != FIXED && d[b] != FIXED {
+                        columns[d[b]].push(d[a]);
+                    }
+                }
+            }
+        }
+        for (j, col) in columns.iter_mut().enumerate() {
+            col.push(j);
+            col.sort_unstable();
+            col.dedup();
+        }
+        let matrix = SparseSystem::new(&columns)?;
+        let maps = rows
+            .iter()
+            .map(|r| {
+                let mut m = Vec::with_capacity(r.len() * r.len());
+                for &j in r {
+                    for &i in r {
+                        m.push(if i == NONE || j == NONE {
+                            NONE
+                        } else {
+                            matrix.position(i as usize, j as usize).map_or(NONE, |p| p as u32)
+                        });
+                    }
+                }
+                m
+            })
+            .collect();
+        let moment_blocks = node_dofs
+            .iter()
+            .map(|d| {
+                let mut b = [NONE; 9];
+                for c in 0..3 {
+                    for r in 0..3 {
+                        let (i, j) = (d[3 + r], d[3 + c]);
+                        if i != FIXED && j != FIXED {
+                            b[3 * c + r] = matrix.position(i, j).map_or(NONE, |p| p as u32);
+                        }
+                    }
+                }
+                b
+            })
+            .collect();
+        let locals = elements
+            .iter()
+            .map(|el| Local::new(6 * el.nodes().len() + el.multipliers()))
+            .collect();
+        let index_of = |id: &NodeId| model.nodes.get_index_of(id).expect("validated model");
+        let loads: Vec<AppliedLoad> = model
+            .loads
+            .iter()
+            .map(|l| AppliedLoad {
+                node: index_of(&l.node),
+                moment: l.moment,
+                value: l.value,
+                function: l.function.and_then(|f| model.functions.get(&f)).map(|f| f.function.clone()),
+            })
+            .collect();
+        let gravity = model.gravity.unwrap_or_else(Vector3::zeros);
+        let (mut lo, mut hi) = (Vector3::repeat(f64::MAX), Vector3::repeat(f64::MIN));
+        for x in &x0 {
+            lo = lo.inf(x);
+            hi = hi.sup(x);
+        }
+        let ref_length = if x0.is_empty() { 1.0 } else { (hi - lo).norm().max(1e-6) };
+        let mut ref_force: f64 = 0.0;
+        for l in &loads {
+            let fmax = l
+                .function
+                .as_ref()
+                .map_or(1.0, |f| match f {
+                    Function::Constant(c) => c.abs(),
+                    Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
+                });
+            let scale = if l.moment { 1.0 / ref_length } else { 1.0 };
+            ref_force = ref_force.max(l.value.norm() * fmax * scale);
+        }
+        Ok(System {
+            rhs: vec![0.0; n],
+            node_ids,
+            x0,
+            elements,
+            node_dofs,
+            mult_offset,
+            n_node_eq,
+            owners,
+            loads,
+            gravity,
+            matrix,
+            locals,
+            rows,
+            maps,
+            moment_blocks,
+            ref_force,
+            ref_length,
+        })
+    }
+
+    /// Number of global equations.
+    pub fn n_eq(&self) -> usize {
+        self.owners.len()
+    }
+
+    /// Multipliers of element `e` within the global multiplier-bearing vector `lambda`
+    /// (indexed by global equation).
+    pub fn element_lambda<'a>(&self, e: usize, lambda: &'a [f64]) -> &'a [f64] {
+        let k = self.elements[e].multipliers();
+        let o = self.mult_offset[e];
+        &lambda[o..o + k]
+    }
+
+    /// Assembles the global residual into [`System::rhs`] and, when `tangent`, the
+    /// iteration matrix into [`System::matrix`]. `lambda` is indexed by global equation.
+    pub fn assemble(&mut self, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64], tangent: bool) -> AssemblyInfo {
+        self.rhs.iter_mut().for_each(|v| *v = 0.0);
+        if tangent {
+            self.matrix.clear();
+        }
+        let mut info = AssemblyInfo::default();
+        for (e, el) in self.elements.iter().enumerate() {
+            let local = &mut self.locals[e];
+            local.clear();
+            let k = el.multipliers();
+            let o = self.mult_offset[e];
+            el.evaluate(ctx, nodes, &lambda[o..o + k], tangent, local);
+            let rows = &self.rows[e];
+            let nn = 6 * el.nodes().len();
+            for (i, &g) in rows.iter().enumerate() {
+                if i < nn {
+                    info.force_scale = info.force_scale.max(local.res[i].abs());
+                }
+                if g != NONE {
+                    self.rhs[g as usize] += local.res[i];
+                }
+            }
+            if tangent {
+                for (p, &pos) in self.maps[e].iter().enumerate() {
+                    if pos != NONE {
+                        self.matrix.values[pos as usize] += local.tan[p];
+                    }
+                }
+            }
+        }
+        for l in &self.loads {
+            let f = l.at(ctx.t);
+            let d = &self.node_dofs[l.node];
+            if l.moment {
+                // Global moment m enters the material equations as −Rᵀm; its derivative
+                // with respect to δΘ is −(Rᵀm)~.
+                let mm = nodes[l.node].r.transpose() * f;
+                for c in 0..3 {
+                    if d[3 + c] != FIXED {
+                        self.rhs[d[3 + c]] -= mm[c];
+                    }
+                }
+                if tangent {
+                    let k = -skew(&mm);
+                    for c in 0..3 {
+                        for r in 0..3 {
+                            let pos = self.moment_blocks[l.node][3 * c + r];
+                            if pos != NONE {
+                                self.matrix.values[pos as usize] += k[(r, c)];
+                            }
+                        }
+                    }
+                }
+            } else {
+                for c in 0..3 {
+                    if d[c] != FIXED {
+                        self.rhs[d[c]] -= f[c];
+                    }
+                }
+            }
+        }
+        info
+    }
+
+    /// Power of the applied loads at `t`, W (forces on velocities, moments on global
+    /// angular velocities).
+    pub fn external_power(&self, t: f64, nodes: &[NodeState]) -> f64 {
+        self.loads
+            .iter()
+            .map(|l| {
+                let s = &nodes[l.node];
+                let f = l.at(t);
+                if l.moment { f.dot(&(s.r * s.w)) } else { f.dot(&s.v) }
+            })
+            .sum()
+    }
+
+    /// Human-readable name of a global equation, e.g. `node 23 uy`.
+    pub fn describe(&self, eq: usize) -> String {
+        const NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
+        match self.owners.get(eq) {
+            Some(DofOwner::Node { node, comp }) => format!("{} {}", self.node_ids[*node], NAMES[*comp]),
+            Some(DofOwner::Multiplier { element, k }) => {
+                format!("{} constraint {}", self.elements[*element].id(), k + 1)
+            }
+            None => format!("equation {eq}"),
+        }
+    }
+}
