@@ -56,7 +56,7 @@ fn malformed_decks_table() {
             "unknown element type `BAEM`",
         ),
         (
-            format!("ANALYSIS DYNAMIC STEP 1 END 2 BETA 3\n"),
+            "ANALYSIS DYNAMIC STEP 1 END 2 BETA 3\n".into(),
             1,
             31,
             "unexpected `BETA`",
@@ -68,7 +68,7 @@ fn malformed_decks_table() {
             "unexpected `COLOR`",
         ),
         (
-            format!("ANALYSIS QUASI\n"),
+            "ANALYSIS QUASI\n".into(),
             1,
             10,
             "expected DYNAMIC or STATIC",
@@ -96,12 +96,7 @@ fn malformed_decks_table() {
             6,
             "not a finite value",
         ),
-        (
-            format!("ANALYSIS STATIC MAXIT 1.5\n"),
-            1,
-            23,
-            "whole number",
-        ),
+        ("ANALYSIS STATIC MAXIT 1.5\n".into(), 1, 23, "whole number"),
         (
             format!("FUNCTIONS\n 1 TABLE 0 0 1\n{A}"),
             2,

@@ -908,10 +908,10 @@ impl<'s> Builder<'s> {
                     Span::new(s1.start, s2.end),
                 ));
             }
-            if let Some((ax, axs)) = axis2 {
-                if ax.cross(&d).norm() <= 1e-6 * d.norm() * ax.norm() {
-                    return Err(DeckError::new(K::Axis2Parallel { element: id }, axs));
-                }
+            if let Some((ax, axs)) = axis2
+                && ax.cross(&d).norm() <= 1e-6 * d.norm() * ax.norm()
+            {
+                return Err(DeckError::new(K::Axis2Parallel { element: id }, axs));
             }
             self.add_element(
                 id,
