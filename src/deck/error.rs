@@ -262,6 +262,39 @@ impl DeckError {
         }
     }
 
+    /// A diagnostic code per kind of mistake, e.g. `mecano::deck::undefined`.
+    pub fn code(&self) -> &'static str {
+        use DeckErrorKind as K;
+        match &self.kind {
+            K::Io { .. } => "mecano::deck::io",
+            K::NotUtf8 { .. } => "mecano::deck::not_utf8",
+            K::EmptyDeck => "mecano::deck::empty",
+            K::MissingAnalysis => "mecano::deck::no_analysis",
+            K::RepeatedCard { .. } => "mecano::deck::repeated_card",
+            K::UnknownSection { .. } | K::CardOutsideSection { .. } => {
+                "mecano::deck::unknown_section"
+            }
+            K::UnknownKeyword { .. } => "mecano::deck::unknown_keyword",
+            K::UnknownElementType { .. } => "mecano::deck::unknown_element",
+            K::ExpectedNumber { .. } | K::ExpectedInteger { .. } | K::NonFinite { .. } => {
+                "mecano::deck::bad_number"
+            }
+            K::MissingField { .. } | K::MissingKeyword { .. } => "mecano::deck::missing",
+            K::ExtraToken { .. } => "mecano::deck::extra",
+            K::RepeatedKeyword { .. } | K::Conflict { .. } => "mecano::deck::conflict",
+            K::Duplicate { .. } => "mecano::deck::duplicate",
+            K::Undefined { .. } => "mecano::deck::undefined",
+            K::BadGeneration { .. } => "mecano::deck::generation",
+            K::BeamSameNode { .. } | K::BeamZeroLength { .. } => "mecano::deck::beam",
+            K::BadAxis { .. }
+            | K::Axis2Parallel { .. }
+            | K::PlaneParallel
+            | K::UJointNotPerpendicular { .. } => "mecano::deck::axis",
+            K::OutOfRange { .. } => "mecano::deck::range",
+            K::OddTable { .. } | K::DecreasingTime { .. } => "mecano::deck::table",
+        }
+    }
+
     /// The short text under the underlined span.
     fn label(&self) -> &'static str {
         use DeckErrorKind as K;
@@ -305,7 +338,7 @@ impl std::error::Error for DeckError {}
 
 impl Diagnostic for DeckError {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        Some(Box::new("mecano::deck"))
+        Some(Box::new(DeckError::code(self)))
     }
 
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
@@ -377,7 +410,9 @@ impl std::error::Error for DeckErrors {}
 
 impl Diagnostic for DeckErrors {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        Some(Box::new("mecano::deck"))
+        Some(Box::new(
+            self.errors.first().map_or("mecano::deck", DeckError::code),
+        ))
     }
 
     fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
