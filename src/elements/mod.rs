@@ -16,7 +16,9 @@
 //! `[δx, δΘ]`, velocities and accelerations), the coefficients coming from the integrator.
 
 pub mod beam;
+pub mod came;
 pub mod mass;
+pub mod profile;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -72,6 +74,13 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
             }
             ElementKind::Mass { mass, inertia } => {
                 out.push(Box::new(mass::PointMass::new(el.id, idx(&el.nodes[0]), *mass, *inertia)));
+            }
+            ElementKind::Came(data) => {
+                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
+                match came::Came::new(el.id, nodes, data) {
+                    Ok(c) => out.push(Box::new(c)),
+                    Err(message) => return Err(BuildError::Invalid { element: el.id, message }),
+                }
             }
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
@@ -273,6 +282,15 @@ pub trait Element: Send + Sync {
     /// current state: for the energy balance.
     fn dissipated_power(&self, _nodes: &[NodeState]) -> f64 {
         0.0
+    }
+
+    /// Event (impact) control of a converged trial step from `old` to `new` (step
+    /// `ctx.h`), asked before the step is committed: the largest step this element accepts
+    /// around this state, or `None` for no limit. The integrator refuses a step longer than
+    /// [`came::LIMIT_SLACK`] times the limit (and retries it with the limit), and caps the
+    /// following steps by it. Default: no limit.
+    fn max_step(&self, _ctx: &EvalContext, _old: &[NodeState], _new: &[NodeState]) -> Option<f64> {
+        None
     }
 }
 

@@ -18,6 +18,9 @@
 
 use super::system::System;
 use super::{Failure, FailureReason, Stats};
+use crate::elements::came::LIMIT_SLACK;
+#[allow(unused_imports)]
+use crate::elements::Element;
 use crate::elements::{Energies, EvalContext, NodeState};
 use crate::model::NewtonSettings;
 use crate::rotation;
@@ -75,6 +78,12 @@ pub struct Integrator {
     pub external_work: f64,
     /// Energy dissipated by element dampers since t = 0, J.
     pub damping_work: f64,
+    /// Largest step the elements allow after the last accepted step ([`Element::max_step`],
+    /// e.g. a contact resolving an impact); infinity = no limit.
+    pub step_cap: f64,
+    /// Steps no longer than this are never refused by [`Element::max_step`] (the run's
+    /// smallest step), so a refusal cannot repeat forever.
+    pub event_floor: f64,
     trial: Vec<NodeState>,
     trial_pseudo: Vec<[Vector3<f64>; 2]>,
     trial_lambda: Vec<f64>,
@@ -117,6 +126,8 @@ impl Integrator {
             stiff_ref: 0.0,
             external_work: 0.0,
             damping_work: 0.0,
+            step_cap: f64::INFINITY,
+            event_floor: 0.0,
             sys,
         }
     }
@@ -345,6 +356,15 @@ impl Integrator {
             }
             let converged = rel <= self.newton.tol_residual && cn <= tol_len && (iter == 0 || last_inc <= self.newton.tol_increment);
             if converged {
+                if self.dynamic {
+                    // Event control before committing: an element may refuse the step.
+                    let (old, new) = (&self.nodes, &self.trial);
+                    let cap = self.sys.elements.iter().filter_map(|e| e.max_step(&ctx, old, new)).fold(f64::INFINITY, f64::min);
+                    if h > LIMIT_SLACK * cap && h > self.event_floor * (1.0 + 1e-9) {
+                        return Err(self.failure(h, FailureReason::StepRefused(cap.max(self.event_floor)), history, fref));
+                    }
+                    self.step_cap = cap;
+                }
                 self.accept(h, &ctx);
                 self.stats.newton_iterations += iter as u64;
                 return Ok(StepInfo {

@@ -44,6 +44,9 @@ pub enum FailureReason {
     NotFinite,
     /// The iteration matrix could not be factored.
     Singular(String),
+    /// Newton converged but an element refused the step as too long (e.g. an impact
+    /// resolved by too few steps): retry with this step, s.
+    StepRefused(f64),
 }
 
 /// The diagnosis of a failed run: where, when and how badly.
@@ -71,6 +74,7 @@ impl std::fmt::Display for Failure {
             FailureReason::NoConvergence(n) => format!("Newton did not converge in {n} iterations"),
             FailureReason::NotFinite => "the solution became non-finite (NaN or infinity)".to_string(),
             FailureReason::Singular(s) => s.clone(),
+            FailureReason::StepRefused(h) => format!("an element refused the step (asks for h <= {h:.3e} s)"),
         };
         writeln!(f, "{why} at t = {:.6e} s with step h = {:.3e} s", self.time, self.step)?;
         let hist: Vec<String> = self.residual_history.iter().map(|r| format!("{r:.2e}")).collect();
@@ -152,6 +156,7 @@ pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observe
     };
     let _ = hmax;
     integ.stats.min_step = f64::INFINITY;
+    integ.event_floor = hmin;
     let mut failure = integ.initialize().err();
     if failure.is_none() {
         obs.state(&Snapshot { integ, step: 0, h: 0.0 })?;
@@ -172,7 +177,7 @@ pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observe
     let eps = 1e-9 * h0;
     while failure.is_none() && integ.t < end - eps {
         let t = integ.t;
-        let mut h_try = h.min(end - t);
+        let mut h_try = h.min(end - t).min(integ.step_cap.max(hmin));
         if let Some(b) = breaks.iter().find(|b| **b > t + eps) {
             if t + h_try > *b - eps {
                 h_try = *b - t;
@@ -196,6 +201,15 @@ pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observe
                     h = (2.0 * h).min(h0);
                     good = 0;
                 }
+            }
+            Err(Failure {
+                reason: FailureReason::StepRefused(h_ok),
+                ..
+            }) => {
+                // An element (e.g. a contact at an impact) asks for a shorter step.
+                integ.stats.rejected_steps += 1;
+                good = 0;
+                h = h_ok.max(hmin).min(h_try);
             }
             Err(f) => {
                 integ.stats.rejected_steps += 1;
