@@ -82,6 +82,7 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     Err(message) => return Err(BuildError::Invalid { element: el.id, message }),
                 }
             }
+            k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }
