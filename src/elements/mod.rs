@@ -17,6 +17,7 @@
 
 pub mod beam;
 pub mod came;
+pub mod joints;
 pub mod mass;
 pub mod profile;
 
