@@ -7,6 +7,7 @@
 
 pub mod app;
 pub mod deck;
+pub mod dual;
 pub mod elements;
 pub mod model;
 pub mod output;

@@ -16,12 +16,13 @@
 //! vectors (`R ← R exp(ΔΘ̃)`), so there is no singularity at `φ = 2π`: a node may turn any
 //! number of times. [`log`] is accurate up to and at `φ = π` (quaternion form).
 
-use nalgebra::{Matrix3, RealField, Vector3};
+use crate::dual::Real;
+use nalgebra::{Matrix3, Vector3};
 
 /// Converts an `f64` constant into the generic scalar.
 #[inline(always)]
-pub fn c<S: RealField + Copy>(x: f64) -> S {
-    nalgebra::convert(x)
+pub fn c<S: Real>(x: f64) -> S {
+    S::cst(x)
 }
 
 /// Below this `φ²` the coefficients use their Taylor series.
@@ -29,14 +30,66 @@ const SERIES_PHI2: f64 = 1e-2;
 
 /// The skew-symmetric matrix `ṽ` with `ṽ w = v × w`.
 #[inline]
-pub fn skew<S: RealField + Copy>(v: &Vector3<S>) -> Matrix3<S> {
+pub fn skew<S: Real>(v: &Vector3<S>) -> Matrix3<S> {
     let z = S::zero();
     Matrix3::new(z, -v.z, v.y, v.z, z, -v.x, -v.y, v.x, z)
 }
 
+/// `a b` for 3×3 matrices, unrolled (nalgebra's generic product is slow for dual scalars).
+#[inline(always)]
+pub fn mm<S: Real>(a: &Matrix3<S>, b: &Matrix3<S>) -> Matrix3<S> {
+    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)])
+}
+
+/// `aᵀ b` for 3×3 matrices, unrolled.
+#[inline(always)]
+pub fn mtm<S: Real>(a: &Matrix3<S>, b: &Matrix3<S>) -> Matrix3<S> {
+    Matrix3::from_fn(|i, j| a[(0, i)] * b[(0, j)] + a[(1, i)] * b[(1, j)] + a[(2, i)] * b[(2, j)])
+}
+
+/// `a v`, unrolled.
+#[inline(always)]
+pub fn mv<S: Real>(a: &Matrix3<S>, v: &Vector3<S>) -> Vector3<S> {
+    Vector3::new(
+        a[(0, 0)] * v.x + a[(0, 1)] * v.y + a[(0, 2)] * v.z,
+        a[(1, 0)] * v.x + a[(1, 1)] * v.y + a[(1, 2)] * v.z,
+        a[(2, 0)] * v.x + a[(2, 1)] * v.y + a[(2, 2)] * v.z,
+    )
+}
+
+/// `aᵀ v`, unrolled.
+#[inline(always)]
+pub fn mtv<S: Real>(a: &Matrix3<S>, v: &Vector3<S>) -> Vector3<S> {
+    Vector3::new(
+        a[(0, 0)] * v.x + a[(1, 0)] * v.y + a[(2, 0)] * v.z,
+        a[(0, 1)] * v.x + a[(1, 1)] * v.y + a[(2, 1)] * v.z,
+        a[(0, 2)] * v.x + a[(1, 2)] * v.y + a[(2, 2)] * v.z,
+    )
+}
+
+/// `Matrix3::identity() + a k + b k²` for a skew `k = Φ̃`, using `Φ̃² = ΦΦᵀ − |Φ|² I`.
+#[inline(always)]
+fn rodrigues_like<S: Real>(phi: &Vector3<S>, a: S, b: S) -> Matrix3<S> {
+    let p2 = phi.x * phi.x + phi.y * phi.y + phi.z * phi.z;
+    let one = S::one();
+    Matrix3::from_fn(|i, j| {
+        let k = match (i, j) {
+            (0, 1) => -phi.z,
+            (0, 2) => phi.y,
+            (1, 0) => phi.z,
+            (1, 2) => -phi.x,
+            (2, 0) => -phi.y,
+            (2, 1) => phi.x,
+            _ => S::zero(),
+        };
+        let k2 = phi[i] * phi[j] - if i == j { p2 } else { S::zero() };
+        (if i == j { one } else { S::zero() }) + a * k + b * k2
+    })
+}
+
 /// The axial vector of the skew part of `m`: `axial(ṽ) = v`.
 #[inline]
-pub fn axial<S: RealField + Copy>(m: &Matrix3<S>) -> Vector3<S> {
+pub fn axial<S: Real>(m: &Matrix3<S>) -> Vector3<S> {
     let h = c::<S>(0.5);
     Vector3::new(
         (m[(2, 1)] - m[(1, 2)]) * h,
@@ -47,7 +100,7 @@ pub fn axial<S: RealField + Copy>(m: &Matrix3<S>) -> Vector3<S> {
 
 /// `(sin φ/φ, (1 − cos φ)/φ², (φ − sin φ)/φ³)` as functions of `φ²`.
 #[inline]
-fn coefficients<S: RealField + Copy>(phi2: S) -> (S, S, S) {
+fn coefficients<S: Real>(phi2: S) -> (S, S, S) {
     if phi2 < c(SERIES_PHI2) {
         let p = phi2;
         let a = S::one() - p / c(6.0) + p * p / c(120.0) - p * p * p / c(5040.0);
@@ -62,25 +115,23 @@ fn coefficients<S: RealField + Copy>(phi2: S) -> (S, S, S) {
 }
 
 /// Exponential map `exp(Φ̃)` (Rodrigues' formula, paper eq. [2]).
-pub fn exp<S: RealField + Copy>(phi: &Vector3<S>) -> Matrix3<S> {
-    let (a, b, _) = coefficients(phi.dot(phi));
-    let k = skew(phi);
-    Matrix3::identity() + k * a + k * k * b
+pub fn exp<S: Real>(phi: &Vector3<S>) -> Matrix3<S> {
+    let (a, b, _) = coefficients(phi.x * phi.x + phi.y * phi.y + phi.z * phi.z);
+    rodrigues_like(phi, a, b)
 }
 
 /// Material tangent operator `T(Φ)`: `δR = R (T(Φ) δΦ)~`, `Ω = T(Φ) Φ̇` (paper eq. [3]).
-pub fn tangent<S: RealField + Copy>(phi: &Vector3<S>) -> Matrix3<S> {
-    let (_, b, d) = coefficients(phi.dot(phi));
-    let k = skew(phi);
-    Matrix3::identity() - k * b + k * k * d
+pub fn tangent<S: Real>(phi: &Vector3<S>) -> Matrix3<S> {
+    let (_, b, d) = coefficients(phi.x * phi.x + phi.y * phi.y + phi.z * phi.z);
+    rodrigues_like(phi, -b, d)
 }
 
 /// Inverse tangent operator `T⁻¹(Φ) = I + ½Φ̃ + (1/φ²)(1 − (φ/2)cot(φ/2)) Φ̃²`.
 ///
 /// Singular at `φ = 2π` only; the code keeps `φ ≤ π` by construction (logs of relative or
 /// incremental rotations).
-pub fn tangent_inv<S: RealField + Copy>(phi: &Vector3<S>) -> Matrix3<S> {
-    let p = phi.dot(phi);
+pub fn tangent_inv<S: Real>(phi: &Vector3<S>) -> Matrix3<S> {
+    let p = phi.x * phi.x + phi.y * phi.y + phi.z * phi.z;
     let e = if p < c(SERIES_PHI2) {
         c::<S>(1.0 / 12.0) + p / c(720.0) + p * p / c(30240.0) + p * p * p / c(1209600.0)
     } else {
@@ -88,13 +139,12 @@ pub fn tangent_inv<S: RealField + Copy>(phi: &Vector3<S>) -> Matrix3<S> {
         let h = phi * c(0.5);
         (S::one() - h * h.cos() / h.sin()) / p
     };
-    let k = skew(phi);
-    Matrix3::identity() + k * c::<S>(0.5) + k * k * e
+    rodrigues_like(phi, c(0.5), e)
 }
 
 /// Unit quaternion `(w, v)` of a rotation matrix, `w ≥ 0` (Shepperd's method, stable for
 /// every rotation).
-pub fn quaternion<S: RealField + Copy>(r: &Matrix3<S>) -> (S, Vector3<S>) {
+pub fn quaternion<S: Real>(r: &Matrix3<S>) -> (S, Vector3<S>) {
     let tr = r[(0, 0)] + r[(1, 1)] + r[(2, 2)];
     let quarter = c::<S>(0.25);
     let (w, v) = if tr >= r[(0, 0)] && tr >= r[(1, 1)] && tr >= r[(2, 2)] {
@@ -143,7 +193,7 @@ pub fn quaternion<S: RealField + Copy>(r: &Matrix3<S>) -> (S, Vector3<S>) {
 
 /// Logarithm of a rotation matrix: the rotation vector `Φ` with `‖Φ‖ ≤ π` and
 /// `exp(Φ̃) = R`. Accurate near 0 (series in `‖v‖²`) and at π (quaternion form).
-pub fn log<S: RealField + Copy>(r: &Matrix3<S>) -> Vector3<S> {
+pub fn log<S: Real>(r: &Matrix3<S>) -> Vector3<S> {
     let (w, v) = quaternion(r);
     let s2 = v.dot(&v);
     // Φ = 2 atan2(|v|, w) v/|v|; the factor is smooth in |v|² near 0.

@@ -17,7 +17,7 @@
 //! `f_x₂ = −f_x₁ = Λ_m N`, `f_θ₁ = exp(ψ̃/2) g − Q T(ψ)⁻ᵀ p`, `f_θ₂ = T(ψ)⁻ᵀ p`
 //! (`Q = Λ₁ᵀΛ₂`; moments in the element frame, turned to the node frame by `Λ₀`).
 //! The tangent stiffness is the exact derivative of these forces, obtained by forward-mode
-//! automatic differentiation (dual numbers, [`num_dual`]) — consistent by construction and
+//! automatic differentiation (dual numbers, [`crate::dual`]) — consistent by construction and
 //! checked against finite differences in the tests.
 //!
 //! # Inertia (paper eqs. [10]–[11])
@@ -26,10 +26,10 @@
 //! gyroscopic force `J Ω̇ + Ω × J Ω`. Gravity: `ρAL g / 2` on each node.
 
 use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
+use crate::dual::{Dual, Real};
 use crate::model::ElementId;
 use crate::rotation::{self, c, skew};
-use nalgebra::{Matrix3, RealField, SVector, Vector3};
-use num_dual::{Derivative, DualSVec64};
+use nalgebra::{Matrix3, Vector3};
 
 /// Section and material properties of a beam, per unit length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,7 +77,7 @@ pub fn reference_triad(x1: &Vector3<f64>, x2: &Vector3<f64>, axis2: &Vector3<f64
 }
 
 /// Kinematic results of the beam kernel.
-struct Kernel<S: RealField + Copy> {
+struct Kernel<S: Real> {
     /// `[f_x1, f_Θ1, f_x2, f_Θ2]` (node frames).
     f: [Vector3<S>; 4],
     gamma: Vector3<S>,
@@ -98,7 +98,9 @@ impl Beam {
         let axis2 = axis2.unwrap_or_else(|| default_axis2(&d));
         let lambda0 = reference_triad(x1, x2, &axis2);
         let length = d.norm();
-        let j_node = lambda0 * Matrix3::from_diagonal(&(props.inertia * (0.5 * length))) * lambda0.transpose();
+        let j_node = lambda0
+            * Matrix3::from_diagonal(&(props.inertia * (0.5 * length)))
+            * lambda0.transpose();
         Beam {
             id,
             nodes,
@@ -115,7 +117,7 @@ impl Beam {
     }
 
     /// The strain kernel, generic in the scalar (f64 or dual numbers).
-    fn kernel<S: RealField + Copy>(
+    fn kernel<S: Real>(
         &self,
         x1: Vector3<S>,
         x2: Vector3<S>,
@@ -124,28 +126,29 @@ impl Beam {
     ) -> Kernel<S> {
         let l0: Matrix3<S> = self.lambda0.map(c);
         let inv_l = c::<S>(1.0 / self.length);
-        let lam1 = r1 * l0;
-        let lam2 = r2 * l0;
-        let q = lam1.transpose() * lam2;
+        let lam1 = rotation::mm(&r1, &l0);
+        let lam2 = rotation::mm(&r2, &l0);
+        let q = rotation::mtm(&lam1, &lam2);
         let psi = rotation::log(&q);
         let half = psi * c::<S>(0.5);
         let e = rotation::exp(&half);
-        let lam_m = lam1 * e;
+        let lam_m = rotation::mm(&lam1, &e);
         let d = x2 - x1;
-        let a = lam_m.transpose() * d;
+        let a = rotation::mtv(&lam_m, &d);
         let gamma = a * inv_l - Vector3::x();
         let kappa = psi * inv_l;
         let cn: Vector3<S> = self.props.cn.map(c);
         let cm: Vector3<S> = self.props.cm.map(c);
         let n = gamma.component_mul(&cn);
         let m = kappa.component_mul(&cm);
-        let force = lam_m * n;
+        let force = rotation::mv(&lam_m, &n);
         let g = n.cross(&a);
-        let p = m + rotation::tangent(&half).transpose() * g * c::<S>(0.5);
-        let qv = rotation::tangent_inv(&psi).transpose() * p;
-        let f1 = e * g - q * qv;
+        let p = m + rotation::mtv(&rotation::tangent(&half), &g) * c::<S>(0.5);
+        let qv = rotation::mtv(&rotation::tangent_inv(&psi), &p);
+        let f1 = rotation::mv(&e, &g) - rotation::mv(&q, &qv);
+        let (m1, m2) = (rotation::mv(&l0, &f1), rotation::mv(&l0, &qv));
         Kernel {
-            f: [-force, l0 * f1, force, l0 * qv],
+            f: [-force, m1, force, m2],
             gamma,
             kappa,
         }
@@ -165,15 +168,17 @@ impl Beam {
     /// Internal forces and their exact derivative with respect to `[δx₁, δΘ₁, δx₂, δΘ₂]`,
     /// by forward-mode AD with 12 dual directions.
     fn internal_with_tangent(&self, s1: &NodeState, s2: &NodeState, out: &mut Local) {
-        type D = DualSVec64<12>;
-        let seed = |v: f64, k: usize| D::new(v, Derivative::derivative_generic(nalgebra::Const::<12>, nalgebra::U1, k));
-        let lift = |v: f64| D::new(v, Derivative::none());
-        let xs = |x: &Vector3<f64>, base: usize| Vector3::new(seed(x.x, base), seed(x.y, base + 1), seed(x.z, base + 2));
+        type D = Dual<12>;
+        let seed = |v: f64, k: usize| D::var(v, k);
+        let lift = D::constant;
+        let xs = |x: &Vector3<f64>, base: usize| {
+            Vector3::new(seed(x.x, base), seed(x.y, base + 1), seed(x.z, base + 2))
+        };
         let rs = |r: &Matrix3<f64>, base: usize| {
             // R (I + δΘ̃): exact to first order, which is all a dual number carries.
             let dth = Vector3::new(seed(0.0, base), seed(0.0, base + 1), seed(0.0, base + 2));
             let rr: Matrix3<D> = r.map(lift);
-            rr + rr * skew(&dth)
+            rr + rotation::mm(&rr, &skew(&dth))
         };
         let k = self.kernel(xs(&s1.x, 0), xs(&s2.x, 6), rs(&s1.r, 3), rs(&s2.r, 9));
         let n = out.n;
@@ -181,11 +186,8 @@ impl Beam {
             for comp in 0..3 {
                 let row = 3 * blk + comp;
                 out.res[row] += v[comp].re;
-                if let Some(eps) = &v[comp].eps.0 {
-                    let eps: &SVector<f64, 12> = eps;
-                    for col in 0..12 {
-                        out.tan[col * n + row] += eps[col];
-                    }
+                for (col, e) in v[comp].eps.iter().enumerate() {
+                    out.tan[col * n + row] += e;
                 }
             }
         }
@@ -205,7 +207,14 @@ impl Element for Beam {
         &self.nodes
     }
 
-    fn evaluate(&self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64], tangent: bool, out: &mut Local) {
+    fn evaluate(
+        &self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        tangent: bool,
+        out: &mut Local,
+    ) {
         let s1 = &nodes[self.nodes[0]];
         let s2 = &nodes[self.nodes[1]];
         if tangent {
@@ -251,7 +260,8 @@ impl Element for Beam {
         let (gamma, kappa) = self.strains(s1, s2);
         let strain = 0.5
             * self.length
-            * (gamma.component_mul(&self.props.cn).dot(&gamma) + kappa.component_mul(&self.props.cm).dot(&kappa));
+            * (gamma.component_mul(&self.props.cn).dot(&gamma)
+                + kappa.component_mul(&self.props.cm).dot(&kappa));
         let m = self.translational_mass();
         let kinetic = m / 6.0 * (s1.v.dot(&s1.v) + s1.v.dot(&s2.v) + s2.v.dot(&s2.v))
             + 0.5 * s1.w.dot(&(self.j_node * s1.w))
@@ -265,17 +275,22 @@ impl Element for Beam {
     }
 
     fn output_header(&self) -> Vec<String> {
-        ["n1", "n2", "n3", "m1", "m2", "m3", "gamma1", "gamma2", "gamma3", "k1", "k2", "k3"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
+        [
+            "n1", "n2", "n3", "m1", "m2", "m3", "gamma1", "gamma2", "gamma3", "k1", "k2", "k3",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
     }
 
     fn output_row(&self, _ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) -> Vec<f64> {
         let (g, k) = self.strains(&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
         let n = g.component_mul(&self.props.cn);
         let m = k.component_mul(&self.props.cm);
-        [n, m, g, k].iter().flat_map(|v| v.iter().copied()).collect()
+        [n, m, g, k]
+            .iter()
+            .flat_map(|v| v.iter().copied())
+            .collect()
     }
 }
 
@@ -379,12 +394,16 @@ mod tests {
         let theta = 0.3;
         let r = l / theta; // arc radius, chord = 2 r sin(θ/2)
         let s1 = NodeState::at_rest(Vector3::zeros());
-        let mut s2 = NodeState::at_rest(Vector3::new(r * theta.sin(), r * (1.0 - theta.cos()), 0.0));
+        let mut s2 =
+            NodeState::at_rest(Vector3::new(r * theta.sin(), r * (1.0 - theta.cos()), 0.0));
         s2.r = rotation::exp(&Vector3::new(0.0, 0.0, theta));
         let (g, k) = b.strains(&s1, &s2);
         assert!((k.z - theta / l).abs() < 1e-12);
         // Midpoint-chord strain of an arc: chord/L·(1/cos 0)… axial strain = 2 sin(θ/2)/θ − 1.
-        assert!((g.x - (2.0 * (theta / 2.0).sin() / theta - 1.0)).abs() < 1e-12, "{g}");
+        assert!(
+            (g.x - (2.0 * (theta / 2.0).sin() / theta - 1.0)).abs() < 1e-12,
+            "{g}"
+        );
         assert!(g.y.abs() < 1e-12);
     }
 }

@@ -18,9 +18,6 @@
 
 use super::system::System;
 use super::{Failure, FailureReason, Stats};
-use crate::elements::came::LIMIT_SLACK;
-#[allow(unused_imports)]
-use crate::elements::Element;
 use crate::elements::{Energies, EvalContext, NodeState};
 use crate::model::NewtonSettings;
 use crate::rotation;
@@ -74,14 +71,18 @@ pub struct Integrator {
     pub mass_ref: f64,
     /// Reference stiffness term (mean translational diagonal stiffness), N/m.
     pub stiff_ref: f64,
+    /// Round-off floor of the residual, N: `10 ε k_max L_ref`. Positions are known to
+    /// `ε |x|`, so a stiffness `k` cannot balance forces better than `ε |x| k`; asking
+    /// Newton for less only makes it fail (a stiff bar under a small load).
+    pub residual_floor: f64,
     /// Work of applied loads since t = 0, J.
     pub external_work: f64,
     /// Energy dissipated by element dampers since t = 0, J.
     pub damping_work: f64,
-    /// Largest step the elements allow after the last accepted step ([`Element::max_step`],
+    /// Largest step the elements allow after the last accepted step ([`crate::elements::Element::step_limit`],
     /// e.g. a contact resolving an impact); infinity = no limit.
     pub step_cap: f64,
-    /// Steps no longer than this are never refused by [`Element::max_step`] (the run's
+    /// Steps no longer than this are never refused by [`crate::elements::Element::step_limit`] (the run's
     /// smallest step), so a refusal cannot repeat forever.
     pub event_floor: f64,
     trial: Vec<NodeState>,
@@ -124,6 +125,7 @@ impl Integrator {
             scale: 1.0,
             mass_ref: 0.0,
             stiff_ref: 0.0,
+            residual_floor: 0.0,
             external_work: 0.0,
             damping_work: 0.0,
             step_cap: f64::INFINITY,
@@ -142,7 +144,10 @@ impl Integrator {
     fn context(&self, t: f64, h: f64, scale: f64) -> EvalContext {
         let (c_v, c_a) = if self.dynamic && h > 0.0 {
             let p = &self.hht;
-            (p.gamma / (p.beta * h), 1.0 / ((1.0 - p.alpha_f) * p.beta * h * h))
+            (
+                p.gamma / (p.beta * h),
+                1.0 / ((1.0 - p.alpha_f) * p.beta * h * h),
+            )
         } else {
             (0.0, 0.0)
         };
@@ -188,13 +193,14 @@ impl Integrator {
         let k_vals = self.sys.matrix.values.clone();
         let ctx1 = EvalContext { c_a: 1.0, ..ctx0 };
         self.sys.assemble(&ctx1, &self.nodes, &zero, true);
-        let (mut msum, mut ksum, mut cnt) = (0.0, 0.0, 0usize);
+        let (mut msum, mut ksum, mut kmax, mut cnt) = (0.0, 0.0, 0.0f64, 0usize);
         for eq in 0..nn {
             if let super::system::DofOwner::Node { comp, .. } = self.sys.owners[eq] {
                 if comp < 3 {
                     if let Some(p) = self.sys.matrix.position(eq, eq) {
                         msum += (self.sys.matrix.values[p] - k_vals[p]).abs();
                         ksum += k_vals[p].abs();
+                        kmax = kmax.max(k_vals[p].abs());
                         cnt += 1;
                     }
                 }
@@ -203,6 +209,7 @@ impl Integrator {
         let cnt = cnt.max(1) as f64;
         self.mass_ref = msum / cnt;
         self.stiff_ref = ksum / cnt;
+        self.residual_floor = 10.0 * f64::EPSILON * kmax * self.sys.ref_length;
         if self.mass_ref == 0.0 && self.stiff_ref == 0.0 {
             self.stiff_ref = 1.0;
         }
@@ -238,7 +245,12 @@ impl Integrator {
             *r = 0.0;
         }
         if let Err(e) = self.sys.matrix.factor() {
-            return Err(self.failure(0.0, FailureReason::Singular(e.to_string()), vec![], info.force_scale));
+            return Err(self.failure(
+                0.0,
+                FailureReason::Singular(e.to_string()),
+                vec![],
+                info.force_scale,
+            ));
         }
         self.stats.factorizations += 1;
         let _ = self.sys.matrix.solve(&mut rhs);
@@ -294,7 +306,11 @@ impl Integrator {
         // Worst equation of the last assembled residual.
         let (mut worst, mut wv) = (0, 0.0f64);
         for (i, r) in self.sys.rhs.iter().enumerate() {
-            let v = if r.is_finite() { r.abs() } else { f64::INFINITY };
+            let v = if r.is_finite() {
+                r.abs()
+            } else {
+                f64::INFINITY
+            };
             if v > wv {
                 wv = v;
                 worst = i;
@@ -305,7 +321,11 @@ impl Integrator {
             step: h,
             reason,
             residual_history: history,
-            worst: if self.sys.n_eq() > 0 { self.sys.describe(worst) } else { "-".into() },
+            worst: if self.sys.n_eq() > 0 {
+                self.sys.describe(worst)
+            } else {
+                "-".into()
+            },
             worst_value: wv,
             reference_force: fref,
         }
@@ -318,7 +338,11 @@ impl Integrator {
         let t1 = self.t + h;
         let p = self.hht;
         // Rescale multipliers to this step's constraint scale.
-        let s_new = if self.dynamic { self.scale_for(h) } else { self.scale };
+        let s_new = if self.dynamic {
+            self.scale_for(h)
+        } else {
+            self.scale
+        };
         let ratio = self.scale / s_new;
         let nn = self.sys.n_node_eq;
         self.trial_lambda.copy_from_slice(&self.lambda);
@@ -345,25 +369,51 @@ impl Integrator {
         let mut fref = self.sys.ref_force;
         for iter in 0..=self.newton.max_iterations {
             self.trial_from_u(h);
-            let info = self.sys.assemble(&ctx, &self.trial, &self.trial_lambda, true);
+            let info = self
+                .sys
+                .assemble(&ctx, &self.trial, &self.trial_lambda, true);
             fref = self.sys.ref_force.max(info.force_scale).max(1e-30);
-            let rn = self.sys.rhs[..nn].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let cn = self.sys.rhs[nn..].iter().fold(0.0f64, |m, v| m.max(v.abs())) / s_new;
-            let rel = rn / fref;
+            let rn = self.sys.rhs[..nn]
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            let cn = self.sys.rhs[nn..]
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+                / s_new;
+            let rel = rn / fref.max(self.residual_floor / self.newton.tol_residual);
             history.push(rel);
             if !rel.is_finite() || !cn.is_finite() {
                 return Err(self.failure(h, FailureReason::NotFinite, history, fref));
             }
-            let converged = rel <= self.newton.tol_residual && cn <= tol_len && (iter == 0 || last_inc <= self.newton.tol_increment);
+            let converged = rel <= self.newton.tol_residual
+                && cn <= tol_len
+                && (iter == 0 || last_inc <= self.newton.tol_increment);
             if converged {
                 if self.dynamic {
                     // Event control before committing: an element may refuse the step.
                     let (old, new) = (&self.nodes, &self.trial);
-                    let cap = self.sys.elements.iter().filter_map(|e| e.max_step(&ctx, old, new)).fold(f64::INFINITY, f64::min);
-                    if h > LIMIT_SLACK * cap && h > self.event_floor * (1.0 + 1e-9) {
-                        return Err(self.failure(h, FailureReason::StepRefused(cap.max(self.event_floor)), history, fref));
+                    let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
+                    for lim in self
+                        .sys
+                        .elements
+                        .iter()
+                        .filter_map(|e| e.step_limit(&ctx, old, new))
+                    {
+                        next = next.min(lim.next);
+                        if h > lim.accept_up_to {
+                            refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
+                        }
                     }
-                    self.step_cap = cap;
+                    if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
+                        let retry = retry.max(self.event_floor).min(0.5 * h);
+                        return Err(self.failure(
+                            h,
+                            FailureReason::StepRefused(retry),
+                            history,
+                            fref,
+                        ));
+                    }
+                    self.step_cap = next;
                 }
                 self.accept(h, &ctx);
                 self.stats.newton_iterations += iter as u64;
@@ -414,9 +464,17 @@ impl Integrator {
     }
 
     fn accept(&mut self, h: f64, ctx: &EvalContext) {
-        let p_old = if self.dynamic { self.sys.external_power(self.t, &self.nodes) } else { 0.0 };
+        let p_old = if self.dynamic {
+            self.sys.external_power(self.t, &self.nodes)
+        } else {
+            0.0
+        };
         let d_old: f64 = if self.dynamic {
-            self.sys.elements.iter().map(|e| e.dissipated_power(&self.nodes)).sum()
+            self.sys
+                .elements
+                .iter()
+                .map(|e| e.dissipated_power(&self.nodes))
+                .sum()
         } else {
             0.0
         };
@@ -433,7 +491,12 @@ impl Integrator {
         if self.dynamic {
             let p_new = self.sys.external_power(self.t, &self.nodes);
             self.external_work += 0.5 * (p_old + p_new) * h;
-            let d_new: f64 = self.sys.elements.iter().map(|e| e.dissipated_power(&self.nodes)).sum();
+            let d_new: f64 = self
+                .sys
+                .elements
+                .iter()
+                .map(|e| e.dissipated_power(&self.nodes))
+                .sum();
             self.damping_work += 0.5 * (d_old + d_new) * h;
         }
         for (e, el) in self.sys.elements.iter_mut().enumerate() {
