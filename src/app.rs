@@ -7,7 +7,7 @@ use crate::deck;
 use crate::model::Model;
 use crate::output::Writer;
 use crate::solver::{self, RunReport};
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
 /// Exit code: the run completed.
@@ -40,10 +40,13 @@ pub fn check(path: &Path) -> u8 {
         Ok(m) => m,
         Err(code) => return code,
     };
-    print!("{}", model.summary());
+    let mut out = std::io::stdout().lock();
+    // A closed pipe (`mecano-rs --check deck | head`) is not an error of ours: ignore it.
+    let _ = write!(out, "{}", model.summary());
     match solver::prepare(&model) {
         Ok(integ) => {
-            println!(
+            let _ = writeln!(
+                out,
                 "equations:   {} ({} nodal, {} multipliers; {} non-zeros in the iteration matrix)",
                 integ.sys.n_eq(),
                 integ.sys.n_node_eq,
@@ -64,28 +67,41 @@ pub fn default_out_dir(path: &Path, model: &Model) -> PathBuf {
     if let Some(d) = &model.output.dir {
         return PathBuf::from(d);
     }
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "deck".into());
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "deck".into());
     PathBuf::from("out").join(stem)
 }
 
 /// Runs a parsed model, writing into `dir`. Returns the report (with a failure if the run
 /// stopped early) or an exit code for errors before the run.
-pub fn run_model(model: &Model, deck_name: &str, dir: &Path, quiet: bool) -> Result<RunReport, (u8, String)> {
+pub fn run_model(
+    model: &Model,
+    deck_name: &str,
+    dir: &Path,
+    quiet: bool,
+) -> Result<RunReport, (u8, String)> {
     let mut integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
-    let mut writer =
-        Writer::create(dir, deck_name, model, &integ.sys).map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+    let mut writer = Writer::create(dir, deck_name, model, &integ.sys)
+        .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
     let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
         let pb = indicatif::ProgressBar::new(1000);
         pb.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {msg} [{elapsed} elapsed, ~{eta} left]")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {msg} [{elapsed} elapsed, ~{eta} left]",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         pb
     });
     if let Some(pb) = bar.clone() {
         writer.progress = Some(Box::new(move |t, end, st| {
             pb.set_position(((t / end) * 1000.0) as u64);
-            pb.set_message(format!("t = {t:.4} s, {} steps, {} Newton iterations", st.steps, st.newton_iterations));
+            pb.set_message(format!(
+                "t = {t:.4} s, {} steps, {} Newton iterations",
+                st.steps, st.newton_iterations
+            ));
         }));
     }
     let result = solver::run_prepared(model, &mut integ, &mut writer);
@@ -126,15 +142,23 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         Ok(m) => m,
         Err(code) => return code,
     };
-    let dir = opts.out_dir.clone().unwrap_or_else(|| default_out_dir(path, &model));
+    let dir = opts
+        .out_dir
+        .clone()
+        .unwrap_or_else(|| default_out_dir(path, &model));
     match run_model(&model, &path.display().to_string(), &dir, opts.quiet) {
         Ok(report) => {
             let st = &report.stats;
-            let per = if st.steps > 0 { st.newton_iterations as f64 / st.steps as f64 } else { 0.0 };
+            let per = if st.steps > 0 {
+                st.newton_iterations as f64 / st.steps as f64
+            } else {
+                0.0
+            };
             match &report.failure {
                 None => {
                     if !opts.quiet {
-                        println!(
+                        let _ = writeln!(
+                            std::io::stdout(),
                             "{}: done, t = {:.6} s, {} steps ({} rejected), {:.2} Newton iterations/step, {:.3} s CPU; output in {}",
                             path.display(),
                             report.time,

@@ -57,6 +57,7 @@ fn keywords_have_docs_and_known_sections() {
         "ELEMENTS",
         "FUNCTIONS",
         "LOADS",
+        "INITIAL",
         "ANALYSIS",
         "OUTPUT",
     ];

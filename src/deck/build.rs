@@ -6,8 +6,8 @@ use super::error::{DeckError, DeckErrorKind as K, line_col};
 use super::lex::Token;
 use crate::model::{
     Adaptive, Analysis, CameData, Element, ElementId, ElementKind, Fixity, Function, FunctionDef,
-    FunctionId, Material, MaterialId, Model, NewtonSettings, NodalLoad, Node, NodeId,
-    OutputRequest, PlacedProfile, Profile, Section as Sec, SectionId, Selection, Span,
+    FunctionId, InitialVelocity, Material, MaterialId, Model, NewtonSettings, NodalLoad, Node,
+    NodeId, OutputRequest, PlacedProfile, Profile, Section as Sec, SectionId, Selection, Span,
 };
 use indexmap::IndexMap;
 use nalgebra::{Matrix3, Vector3};
@@ -247,6 +247,7 @@ struct Builder<'s> {
     elements: IndexMap<ElementId, Element>,
     loads: Vec<NodalLoad>,
     gravity: Option<(Vector3<f64>, Span)>,
+    initial: Vec<InitialVelocity>,
     analysis: Option<(Analysis, Span)>,
     output: Option<(OutputRequest, Span)>,
 }
@@ -1108,6 +1109,62 @@ impl<'s> Builder<'s> {
         Ok(())
     }
 
+    // ---------------------------------------------------------------- INITIAL
+    /// `<n> [TO <n2>] [V vx vy vz] [W wx wy wz] [ABOUT cx cy cz]`: with ABOUT, each node
+    /// gets the rigid-body velocity `V + W × (x − c)`.
+    fn initial(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "INITIAL card");
+        let (first, fs) = c.uint("node number")?;
+        let mut last = first;
+        let mut last_span = fs;
+        if c.keyword(&["TO"]).is_some() {
+            (last, last_span) = c.uint("last node number")?;
+            if last < first {
+                return Err(DeckError::new(
+                    K::BadGeneration {
+                        first,
+                        last,
+                        reason: "the last number must not be smaller than the first".into(),
+                    },
+                    Span::new(fs.start, last_span.end),
+                ));
+            }
+        }
+        let mut v = Vector3::zeros();
+        let mut w = Vector3::zeros();
+        let mut about = None;
+        if c.keyword(&["V"]).is_some() {
+            v = c.vec3("V")?.0;
+        }
+        if c.keyword(&["W"]).is_some() {
+            w = c.vec3("W")?.0;
+        }
+        if c.keyword(&["ABOUT"]).is_some() {
+            about = Some(c.vec3("ABOUT")?.0);
+        }
+        c.finish()?;
+        for id in first..=last {
+            let s = if id == first { fs } else { last_span };
+            let node = self.node_ref(id, s)?;
+            let x = self
+                .nodes
+                .get(&node)
+                .map_or_else(Vector3::zeros, |n| n.position);
+            let vel = match about {
+                Some(c0) => v + w.cross(&(x - c0)),
+                None => v,
+            };
+            self.initial.push(InitialVelocity {
+                node,
+                velocity: vel,
+                angular: w,
+                span,
+            });
+        }
+        Ok(())
+    }
+
     // ---------------------------------------------------------------- ANALYSIS
     fn analysis(&mut self, card: &Card<'_>) -> R<()> {
         let span = card.span();
@@ -1365,6 +1422,7 @@ pub(crate) fn build_model(
         elements: IndexMap::new(),
         loads: Vec::new(),
         gravity: None,
+        initial: Vec::new(),
         analysis: None,
         output: None,
     };
@@ -1403,6 +1461,10 @@ pub(crate) fn build_model(
         let r = b.load(c);
         b.push(r);
     }
+    for c in of(Section::Initial) {
+        let r = b.initial(c);
+        b.push(r);
+    }
     for c in of(Section::Analysis) {
         let r = b.analysis(c);
         b.push(r);
@@ -1437,6 +1499,7 @@ pub(crate) fn build_model(
         elements: b.elements,
         loads: b.loads,
         gravity: b.gravity.map(|g| g.0),
+        initial: b.initial,
         analysis,
         output: b.output.map(|o| o.0).unwrap_or_default(),
     })

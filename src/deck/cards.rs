@@ -1,7 +1,7 @@
 //! Stage 1 (syntax): logical lines → cards grouped by section.
 //!
 //! A line whose first token is a section keyword opens that section. `MATERIALS`,
-//! `SECTIONS`, `NODES`, `ELEMENTS`, `FUNCTIONS` and `LOADS` are block sections: their
+//! `SECTIONS`, `NODES`, `ELEMENTS`, `FUNCTIONS`, `LOADS` and `INITIAL` are block sections: their
 //! header stands alone and the following lines are their cards. `TITLE`, `ANALYSIS` and
 //! `OUTPUT` are one-line sections: the line is the card. `END` stops reading.
 
@@ -19,13 +19,14 @@ pub(crate) enum Section {
     Elements,
     Functions,
     Loads,
+    Initial,
     Analysis,
     Output,
 }
 
 impl Section {
     /// Section keywords (the `END` terminator is handled apart).
-    const ALL: [(&'static str, Section); 9] = [
+    const ALL: [(&'static str, Section); 10] = [
         ("TITLE", Section::Title),
         ("MATERIALS", Section::Materials),
         ("SECTIONS", Section::Sections),
@@ -33,6 +34,7 @@ impl Section {
         ("ELEMENTS", Section::Elements),
         ("FUNCTIONS", Section::Functions),
         ("LOADS", Section::Loads),
+        ("INITIAL", Section::Initial),
         ("ANALYSIS", Section::Analysis),
         ("OUTPUT", Section::Output),
     ];
@@ -51,8 +53,7 @@ impl Section {
     }
 }
 
-const SECTION_LIST: &str =
-    "TITLE, MATERIALS, SECTIONS, NODES, ELEMENTS, FUNCTIONS, LOADS, ANALYSIS, OUTPUT or END";
+const SECTION_LIST: &str = "TITLE, MATERIALS, SECTIONS, NODES, ELEMENTS, FUNCTIONS, LOADS, INITIAL, ANALYSIS, OUTPUT or END";
 
 /// One card: the tokens of a logical line, in the section it belongs to. For one-line
 /// sections the first token is the section keyword itself.

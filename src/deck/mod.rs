@@ -64,6 +64,18 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "deck",
         "section header: GRAVITY, FORCE and MOMENT cards follow",
     ),
+    kw(
+        "INITIAL",
+        "deck",
+        "section header: initial-velocity cards follow",
+    ),
+    kw("V", "INITIAL", "initial velocity, global, m/s"),
+    kw("W", "INITIAL", "initial angular velocity, global, rad/s"),
+    kw(
+        "ABOUT",
+        "INITIAL",
+        "centre of a rigid-body velocity field V + W × (x − c)",
+    ),
     kw("ANALYSIS", "deck", "one-line section: the analysis to run"),
     kw(
         "OUTPUT",

@@ -200,6 +200,18 @@ pub fn write_deck(model: &Model) -> String {
             s.push('\n');
         }
     }
+    if !model.initial.is_empty() {
+        s.push_str("INITIAL\n");
+        for iv in &model.initial {
+            let _ = writeln!(
+                s,
+                "  {} V {} W {}",
+                iv.node.0,
+                v3(&iv.velocity),
+                v3(&iv.angular)
+            );
+        }
+    }
     match &model.analysis {
         Analysis::Dynamic {
             alpha,

@@ -303,6 +303,19 @@ pub struct NodalLoad {
     pub span: Span,
 }
 
+/// An initial velocity of a node (global frame), from the deck's INITIAL section.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialVelocity {
+    /// The node.
+    pub node: NodeId,
+    /// Velocity, m/s.
+    pub velocity: Vector3<f64>,
+    /// Angular velocity, rad/s (global frame).
+    pub angular: Vector3<f64>,
+    /// Where it was defined.
+    pub span: Span,
+}
+
 /// Newton–Raphson settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NewtonSettings {
@@ -422,6 +435,8 @@ pub struct Model {
     pub loads: Vec<NodalLoad>,
     /// Gravity acceleration vector, m/s²; `None` = no gravity.
     pub gravity: Option<Vector3<f64>>,
+    /// Initial velocities (nodes not listed start at rest).
+    pub initial: Vec<InitialVelocity>,
     /// The analysis.
     pub analysis: Analysis,
     /// Output requests.

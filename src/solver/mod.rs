@@ -72,12 +72,24 @@ impl std::fmt::Display for Failure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let why = match &self.reason {
             FailureReason::NoConvergence(n) => format!("Newton did not converge in {n} iterations"),
-            FailureReason::NotFinite => "the solution became non-finite (NaN or infinity)".to_string(),
+            FailureReason::NotFinite => {
+                "the solution became non-finite (NaN or infinity)".to_string()
+            }
             FailureReason::Singular(s) => s.clone(),
-            FailureReason::StepRefused(h) => format!("an element refused the step (asks for h <= {h:.3e} s)"),
+            FailureReason::StepRefused(h) => {
+                format!("an element refused the step (asks for h <= {h:.3e} s)")
+            }
         };
-        writeln!(f, "{why} at t = {:.6e} s with step h = {:.3e} s", self.time, self.step)?;
-        let hist: Vec<String> = self.residual_history.iter().map(|r| format!("{r:.2e}")).collect();
+        writeln!(
+            f,
+            "{why} at t = {:.6e} s with step h = {:.3e} s",
+            self.time, self.step
+        )?;
+        let hist: Vec<String> = self
+            .residual_history
+            .iter()
+            .map(|r| format!("{r:.2e}"))
+            .collect();
         writeln!(f, "  relative residual by iteration: [{}]", hist.join(", "))?;
         write!(
             f,
@@ -131,7 +143,9 @@ pub enum RunError {
 pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     let sys = System::new(model)?;
     Ok(match &model.analysis {
-        Analysis::Dynamic { alpha, newton, .. } => Integrator::new(sys, newton.clone(), *alpha, true),
+        Analysis::Dynamic { alpha, newton, .. } => {
+            Integrator::new(sys, newton.clone(), *alpha, true)
+        }
         Analysis::Static { newton, .. } => Integrator::new(sys, newton.clone(), 0.0, false),
     })
 }
@@ -143,11 +157,19 @@ pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<RunReport, RunError>
 }
 
 /// Runs an already prepared integrator (lets callers set initial conditions first).
-pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observer) -> Result<RunReport, RunError> {
+pub fn run_prepared(
+    model: &Model,
+    integ: &mut Integrator,
+    obs: &mut dyn Observer,
+) -> Result<RunReport, RunError> {
     let start = Instant::now();
     let (end, h0, hmin, hmax) = match &model.analysis {
         Analysis::Dynamic {
-            step, end, min_step, max_step, ..
+            step,
+            end,
+            min_step,
+            max_step,
+            ..
         } => (*end, *step, *min_step, *max_step),
         Analysis::Static { steps, .. } => {
             let h = 1.0 / f64::from((*steps).max(1));
@@ -159,7 +181,11 @@ pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observe
     integ.event_floor = hmin;
     let mut failure = integ.initialize().err();
     if failure.is_none() {
-        obs.state(&Snapshot { integ, step: 0, h: 0.0 })?;
+        obs.state(&Snapshot {
+            integ,
+            step: 0,
+            h: 0.0,
+        })?;
     }
     // Breakpoints of load functions: steps land on them rather than straddle a kink.
     let mut breaks: Vec<f64> = integ
@@ -206,12 +232,18 @@ pub fn run_prepared(model: &Model, integ: &mut Integrator, obs: &mut dyn Observe
                 reason: FailureReason::StepRefused(h_ok),
                 ..
             }) => {
-                // An element (e.g. a contact at an impact) asks for a shorter step.
+                    eprintln!("t {} h {} refused -> {}", integ.t, h_try, h_ok);
+                }
                 integ.stats.rejected_steps += 1;
                 good = 0;
                 h = h_ok.max(hmin).min(h_try);
             }
             Err(f) => {
+                    eprintln!(
+                        "t {} h {} {:?} {:?}",
+                        integ.t, h_try, f.reason, f.residual_history
+                    );
+                }
                 integ.stats.rejected_steps += 1;
                 good = 0;
                 h = h_try / 2.0;
