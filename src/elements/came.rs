@@ -44,7 +44,8 @@
 //! # Active set and impacts
 //! The active set is decided from the state being evaluated. Newton must not chatter
 //! between contact and separation: within one step attempt (same `t`, `h`), after
-//! [`MAX_FLIPS`] changes of the active flag the flag is frozen for the rest of that attempt.
+//! [`MAX_FLIPS`] changes of the active flag the flag is frozen, for the rest of that
+//! attempt, at its last value.
 //! After a converged step, [`Element::max_step`] estimates the contact frequency from the
 //! converged state (`ω² = k/m_eff`, `m_eff = P / q̈_n`, the effective mass seen by the
 //! contact force), and asks for steps no longer than `π/(ω · impact_steps)`; a step that
@@ -54,10 +55,9 @@
 //! When the bodies are apart, evaluation costs one transformation of `p` and a distance
 //! check (exact for lines and circles, a bounding circle for closed splines).
 
-use super::profile::{Curve, Projection};
-use super::{Element, Energies, EvalContext, Local, NodeState};
+use super::profile::{Curve, Projection, c};
+use super::{Element, Energies, EvalContext, Local, NodeState, StepLimit};
 use crate::model::{CameData, ElementId, Profile};
-use crate::rotation::{c, skew};
 use nalgebra::{Matrix3, RealField, SVector, Vector2, Vector3};
 use num_dual::{Derivative, DualSVec64};
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
@@ -68,6 +68,10 @@ pub const MAX_FLIPS: u32 = 4;
 /// A step is refused when it is longer than this factor times the impact step limit
 /// (slack so that the limit, re-estimated at each step, does not make steps chatter).
 pub const LIMIT_SLACK: f64 = 1.5;
+
+/// A step that crosses a contact event should end past it by about this fraction of an
+/// impact step (and is refused beyond twice that).
+pub const LAND: f64 = 0.02;
 
 /// The kinematic and force quantities of a contact at a state.
 #[derive(Debug, Clone, Copy)]
@@ -122,6 +126,8 @@ pub struct Came {
     dissipated: f64,
     last_power: f64,
     omega: f64,
+    /// ω estimated at the last trial state (bits of an f64).
+    omega_trial: AtomicU64,
     // Per-attempt active-set memory (interior mutability: `evaluate` takes `&self`).
     attempt: AtomicU64,
     flips: AtomicU32,
@@ -180,6 +186,7 @@ impl Came {
             dissipated: 0.0,
             last_power: 0.0,
             omega: 0.0,
+            omega_trial: AtomicU64::new(0),
             attempt: AtomicU64::new(u64::MAX),
             flips: AtomicU32::new(0),
             last_flag: AtomicBool::new(false),
@@ -280,6 +287,14 @@ impl Came {
         Some(st)
     }
 
+    /// The contact state at `nodes` in f64, computed even when the bodies are apart.
+    pub fn full_state(&self, nodes: &[NodeState]) -> ContactState<f64> {
+        let l = self.local_point(nodes);
+        let eta0 = self.curve.closest_parameter(&Vector2::new(l.x, l.y));
+        let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
+        self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false)
+    }
+
     /// The normal force actually applied (compressive, N) for a contact state.
     fn applied(&self, st: &ContactState<f64>) -> f64 {
         if st.gap >= 0.0 {
@@ -366,9 +381,14 @@ impl Element for Came {
         tangent: bool,
         out: &mut Local,
     ) {
-        let Some(eta0) = self.candidate(nodes) else {
-            self.active_flag(ctx, false);
-            return;
+        let eta0 = match self.candidate(nodes) {
+            Some(e) => e,
+            // Apart: nothing to compute, unless the active set is frozen in contact.
+            None if !self.active_flag(ctx, false) => return,
+            None => {
+                let l = self.local_point(nodes);
+                self.curve.closest_parameter(&Vector2::new(l.x, l.y))
+            }
         };
         let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
         let st = self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false);
@@ -409,7 +429,18 @@ impl Element for Came {
         let rs = |r: &Matrix3<f64>, base: usize| {
             let dth = Vector3::new(seed(base), seed(base + 1), seed(base + 2));
             let rr: Matrix3<D12> = r.map(lift);
-            rr + rr * skew(&dth)
+            rr + rr
+                * Matrix3::new(
+                    lift(0.0),
+                    -dth.z,
+                    dth.y,
+                    dth.z,
+                    lift(0.0),
+                    -dth.x,
+                    -dth.y,
+                    dth.x,
+                    lift(0.0),
+                )
         };
         let st = self.kernel(
             [xs(&a.x, 0), xs(&b.x, 6)],
@@ -488,12 +519,7 @@ impl Element for Came {
     fn output_row(&self, _ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) -> Vec<f64> {
         let Some(st) = self.state(nodes) else {
             // Apart: the gap still, from a projection (output only, once per step).
-            let l = self.local_point(nodes);
-            let l2 = Vector2::new(l.x, l.y);
-            let eta0 = self.curve.closest_parameter(&l2);
-            let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
-            let st = self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false);
-            return self.row(nodes, &st, 0.0, 0.0);
+            return self.row(nodes, &self.full_state(nodes), 0.0, 0.0);
         };
         let p = self.applied(&st);
         let ft = if self.mu > 0.0 && p != 0.0 {
@@ -517,28 +543,91 @@ impl Element for Came {
         self.state(nodes).map_or(0.0, |st| self.power(&st))
     }
 
-    fn max_step(&self, ctx: &EvalContext, old: &[NodeState], new: &[NodeState]) -> Option<f64> {
-        let n_steps = f64::from(self.impact_steps);
-        let st1 = self.state(new);
-        if let Some(st) = st1.as_ref().filter(|s| s.gap < 0.0) {
-            let w = self.omega_estimate(new, st).unwrap_or(self.omega);
-            return (w > 0.0).then(|| std::f64::consts::PI / (w * n_steps));
-        }
-        // Apart at the end: did the step jump over a whole impact?
-        let st0 = self.state(old)?;
-        let st1 = st1?;
-        if st0.gap >= 0.0
-            && st0.gap_rate < 0.0
-            && st1.gap_rate > 0.0
-            && st0.gap + st0.gap_rate * ctx.h < 0.0
+    fn step_limit(
+        &self,
+        ctx: &EvalContext,
+        old: &[NodeState],
+        new: &[NodeState],
+    ) -> Option<StepLimit> {
+        let h = ctx.h;
+        let (st0, st1) = (self.full_state(old), self.full_state(new));
+        let (in0, in1) = (st0.gap < 0.0, st1.gap < 0.0);
+        if let Some(w) = Some(st1)
+            .filter(|_| in1)
+            .and_then(|s| self.omega_estimate(new, &s))
         {
-            return Some(if self.omega > 0.0 {
-                std::f64::consts::PI / (self.omega * n_steps)
-            } else {
-                ctx.h / (2.0 * LIMIT_SLACK)
-            });
+            self.omega_trial.store(w.to_bits(), Ordering::Relaxed);
         }
-        None
+        let omega = match f64::from_bits(self.omega_trial.load(Ordering::Relaxed)) {
+            w if in1 && w > 0.0 => w,
+            _ => self.omega,
+        };
+        // Steps per impact: π/ω split in `impact_steps`; unknown before the first contact.
+        let h_imp = if omega > 0.0 {
+            std::f64::consts::PI / (omega * f64::from(self.impact_steps))
+        } else {
+            f64::INFINITY
+        };
+        let land = if h_imp.is_finite() { LAND * h_imp } else { 0.0 };
+        // Linear estimates of the time to the next event (contact or separation) from a state.
+        let time_to_event = |st: &ContactState<f64>, nodes: &[NodeState]| -> Option<f64> {
+            if st.gap >= 0.0 {
+                return (st.gap_rate < 0.0).then(|| st.gap / -st.gap_rate);
+            }
+            let mut t = (st.gap_rate > 0.0).then(|| -st.gap / st.gap_rate);
+            if self.clip {
+                let p = -(self.k * st.gap + self.c * st.gap_rate);
+                let pdot =
+                    -(self.k * st.gap_rate + self.c * self.gap_acceleration(nodes, &st.normal));
+                if p > 0.0 && pdot < 0.0 {
+                    t = Some(t.map_or(p / -pdot, |t: f64| t.min(p / -pdot)));
+                }
+            }
+            t
+        };
+        let refuse = |retry: f64| {
+            Some(StepLimit {
+                accept_up_to: 0.0,
+                retry,
+                next: retry,
+            })
+        };
+        let retry_from_old = || match time_to_event(&st0, old) {
+            Some(t) if t < h => t + land.max(1e-3 * t),
+            _ => h / 4.0,
+        };
+        if in0 != in1 {
+            // The contact state changed inside the step: the step must land just past the
+            // event, i.e. spend no more than a small part of an impact beyond it.
+            // Linear estimate of the time since the event, backwards from the end.
+            let past = if st1.gap_rate == 0.0 {
+                0.0
+            } else {
+                (st1.gap / st1.gap_rate).abs()
+            };
+            if h_imp.is_finite() && past > 2.0 * LAND * h_imp + 1e-12 {
+                return refuse(retry_from_old().min(h_imp));
+            }
+        } else if !in1 {
+            // Apart at both ends: did the step jump over a whole impact?
+            let (s0, s1) = (st0, st1);
+            if s0.gap_rate < 0.0 && s1.gap_rate > 0.0 && s0.gap + s0.gap_rate * h < 0.0 {
+                return refuse(retry_from_old().min(h_imp));
+            }
+        } else if h > LIMIT_SLACK * h_imp {
+            return refuse(h_imp);
+        }
+        // Accepted: cap the next step at the impact resolution and at the next event.
+        let st = st1;
+        let mut next = if in1 { h_imp } else { f64::INFINITY };
+        if let Some(t) = time_to_event(&st, new) {
+            next = next.min(t + land.max(1e-3 * t));
+        }
+        next.is_finite().then_some(StepLimit {
+            accept_up_to: f64::INFINITY,
+            retry: next,
+            next,
+        })
     }
 }
 

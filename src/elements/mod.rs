@@ -287,13 +287,23 @@ pub trait Element: Send + Sync {
     }
 
     /// Event (impact) control of a converged trial step from `old` to `new` (step
-    /// `ctx.h`), asked before the step is committed: the largest step this element accepts
-    /// around this state, or `None` for no limit. The integrator refuses a step longer than
-    /// [`came::LIMIT_SLACK`] times the limit (and retries it with the limit), and caps the
-    /// following steps by it. Default: no limit.
-    fn max_step(&self, _ctx: &EvalContext, _old: &[NodeState], _new: &[NodeState]) -> Option<f64> {
+    /// `ctx.h`), asked before the step is committed. `None` = no opinion (the default).
+    /// The integrator refuses the step when `ctx.h > accept_up_to` (and retries with
+    /// `retry`), and otherwise caps the next step at `next`.
+    fn step_limit(&self, _ctx: &EvalContext, _old: &[NodeState], _new: &[NodeState]) -> Option<StepLimit> {
         None
     }
+}
+
+/// An element's verdict on a converged step (see [`Element::step_limit`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepLimit {
+    /// Refuse the step if it was longer than this, s.
+    pub accept_up_to: f64,
+    /// The step to retry with when refused, s.
+    pub retry: f64,
+    /// The largest next step when accepted, s.
+    pub next: f64,
 }
 
 /// Index of node `k`'s translational block in a local vector.

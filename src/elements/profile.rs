@@ -20,7 +20,6 @@
 //! function theorem) and the curve's curvature enters the contact tangent automatically.
 
 use crate::model::Profile;
-use crate::rotation::c;
 use nalgebra::{RealField, Vector2};
 
 /// A contact curve ("surface" role): a line, a circle or a spline.
@@ -90,7 +89,7 @@ impl Curve {
                 eta: l.x,
             },
             Curve::Circle(r) => {
-                let nrm = l.norm();
+                let nrm = l.dot(l).sqrt();
                 let nu = if nrm > c(0.0) {
                     *l / nrm
                 } else {
@@ -314,14 +313,14 @@ impl Spline {
     /// exact first derivative of the closest point.
     pub fn project<S: RealField + Copy>(&self, l: &Vector2<S>, eta0: f64) -> Projection<S> {
         let (g, g1, g2) = self.eval(eta0);
-        let lv: Vector2<f64> = l.map(|v| v.to_subset().unwrap_or(0.0));
+        let lv: Vector2<f64> = l.map(|v| v.to_subset().unwrap_or(f64::NAN));
         let gs: Vector2<S> = g.map(c);
         let g1s: Vector2<S> = g1.map(c);
         let f = g1s.dot(&(*l - gs));
         let df = g2.dot(&(lv - g)) - g1.norm_squared();
         let eta = c::<S>(eta0) - f / c::<S>(df);
         let (p, t, _) = self.eval_g(eta, eta0);
-        let t = t / t.norm();
+        let t = t / t.dot(&t).sqrt();
         let side = c::<S>(self.side);
         Projection {
             point: p,
@@ -329,6 +328,12 @@ impl Spline {
             eta,
         }
     }
+}
+
+/// Converts an `f64` constant into the generic scalar.
+#[inline(always)]
+pub(crate) fn c<S: RealField + Copy>(x: f64) -> S {
+    nalgebra::convert(x)
 }
 
 /// Solves the dense system `A x = b` (partial pivoting) for vector right-hand sides.
