@@ -232,18 +232,12 @@ pub fn run_prepared(
                 reason: FailureReason::StepRefused(h_ok),
                 ..
             }) => {
-                    eprintln!("t {} h {} refused -> {}", integ.t, h_try, h_ok);
-                }
+                // An element (e.g. a contact at an impact) asks for a shorter step.
                 integ.stats.rejected_steps += 1;
                 good = 0;
                 h = h_ok.max(hmin).min(h_try);
             }
             Err(f) => {
-                    eprintln!(
-                        "t {} h {} {:?} {:?}",
-                        integ.t, h_try, f.reason, f.residual_history
-                    );
-                }
                 integ.stats.rejected_steps += 1;
                 good = 0;
                 h = h_try / 2.0;
