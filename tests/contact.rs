@@ -170,23 +170,3 @@ fn sliding_with_friction_stops_at_v0_squared_over_2_mu_g() {
     assert!((dist - exact).abs() < 0.01 * exact);
 }
 
-#[test]
-#[ignore]
-fn debug_steps() {
-    struct P;
-    impl Observer for P {
-        fn state(&mut self, snap: &Snapshot) -> std::io::Result<()> {
-            let s = &snap.integ.nodes[1];
-            println!(
-                "t {:.9e} h {:.3e} y {:.4e} vy {:.5} rej {}",
-                snap.integ.t, snap.h, s.x.y, s.v.y, snap.integ.stats.rejected_steps
-            );
-            Ok(())
-        }
-    }
-    let model = load("contact_bounce.dat");
-    let mut integ = solver::prepare(&model).unwrap();
-    integ.set_velocity(1, Vector3::new(0.0, -0.443, 0.0), Vector3::zeros());
-    let rep = solver::run_prepared(&model, &mut integ, &mut P).unwrap();
-    println!("{:?}", rep.failure);
-}
