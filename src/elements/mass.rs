@@ -39,7 +39,14 @@ impl Element for PointMass {
         &self.node
     }
 
-    fn evaluate(&self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64], tangent: bool, out: &mut Local) {
+    fn evaluate(
+        &self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        tangent: bool,
+        out: &mut Local,
+    ) {
         let s = &nodes[self.node[0]];
         out.add_res(tx(0), &(-ctx.gravity * self.mass));
         if !ctx.dynamic {

@@ -93,8 +93,10 @@ impl Model {
                         e.rigid_bodies = true;
                     } else {
                         e.flexible_beams = true;
-                        e.material_damping |=
-                            self.materials.get(material).is_some_and(|m| m.damping > 0.0);
+                        e.material_damping |= self
+                            .materials
+                            .get(material)
+                            .is_some_and(|m| m.damping > 0.0);
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
@@ -148,7 +150,11 @@ impl fmt::Display for Summary {
             .map(|(k, n)| format!("{n} {k}"))
             .collect();
         writeln!(f, "elements:    {total} ({})", parts.join(", "))?;
-        writeln!(f, "dofs:        {} free nodal degrees of freedom", self.dofs)?;
+        writeln!(
+            f,
+            "dofs:        {} free nodal degrees of freedom",
+            self.dofs
+        )?;
         writeln!(f, "constraints: {} equations", self.constraints)?;
         let eff = self.effects.names();
         writeln!(

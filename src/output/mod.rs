@@ -30,8 +30,7 @@ use std::path::{Path, PathBuf};
 pub const NODE_HEADER: &str = "t,x,y,z,ux,uy,uz,rx,ry,rz,vx,vy,vz,wx,wy,wz,ax,ay,az";
 
 /// Header of `energy.csv`.
-pub const ENERGY_HEADER: &str =
-    "t,kinetic,strain,gravity,total,external_work,damping_dissipation,numerical_dissipation,balance_residual";
+pub const ENERGY_HEADER: &str = "t,kinetic,strain,gravity,total,external_work,damping_dissipation,numerical_dissipation,balance_residual";
 
 struct Stream {
     w: BufWriter<File>,
@@ -90,17 +89,26 @@ impl Writer {
         let node_idx: Vec<usize> = match &model.output.nodes {
             Selection::All => (0..model.nodes.len()).collect(),
             Selection::None => Vec::new(),
-            Selection::List(l) => l.iter().filter_map(|id| model.nodes.get_index_of(id)).collect(),
+            Selection::List(l) => l
+                .iter()
+                .filter_map(|id| model.nodes.get_index_of(id))
+                .collect(),
         };
         let mut nodes = Vec::new();
         for i in node_idx {
             let id = sys.node_ids[i].0;
-            nodes.push((i, Stream::create(&dir.join(format!("node_{id}.csv")), NODE_HEADER)?));
+            nodes.push((
+                i,
+                Stream::create(&dir.join(format!("node_{id}.csv")), NODE_HEADER)?,
+            ));
         }
         let elem_idx: Vec<usize> = match &model.output.elements {
             Selection::All => (0..model.elements.len()).collect(),
             Selection::None => Vec::new(),
-            Selection::List(l) => l.iter().filter_map(|id| model.elements.get_index_of(id)).collect(),
+            Selection::List(l) => l
+                .iter()
+                .filter_map(|id| model.elements.get_index_of(id))
+                .collect(),
         };
         let mut elements = Vec::new();
         for e in elem_idx {
@@ -110,7 +118,10 @@ impl Writer {
                 continue;
             }
             let head = format!("t,{}", header.join(","));
-            elements.push((e, Stream::create(&dir.join(format!("element_{}.csv", el.id().0)), &head)?));
+            elements.push((
+                e,
+                Stream::create(&dir.join(format!("element_{}.csv", el.id().0)), &head)?,
+            ));
         }
         let end = match model.analysis {
             crate::model::Analysis::Dynamic { end, .. } => end,
@@ -151,8 +162,8 @@ impl Writer {
             let phi = rotation::log(&s.r);
             let w = s.r * s.w;
             let row = [
-                t, s.x.x, s.x.y, s.x.z, u.x, u.y, u.z, phi.x, phi.y, phi.z, s.v.x, s.v.y, s.v.z, w.x, w.y, w.z, s.a.x,
-                s.a.y, s.a.z,
+                t, s.x.x, s.x.y, s.x.z, u.x, u.y, u.z, phi.x, phi.y, phi.z, s.v.x, s.v.y, s.v.z,
+                w.x, w.y, w.z, s.a.x, s.a.y, s.a.z,
             ];
             st.row(&row)?;
         }
@@ -200,7 +211,11 @@ impl Writer {
         self.energy.w.flush()
     }
 
-    fn write_summary(&self, report: Option<&RunReport>, extra: Option<serde_json::Value>) -> io::Result<()> {
+    fn write_summary(
+        &self,
+        report: Option<&RunReport>,
+        extra: Option<serde_json::Value>,
+    ) -> io::Result<()> {
         let complete = report.is_some_and(|r| r.failure.is_none());
         let mut v = serde_json::json!({
             "deck": self.deck,
@@ -213,8 +228,11 @@ impl Writer {
             let st = &r.stats;
             v["time_reached"] = serde_json::json!(r.time);
             v["stats"] = serde_json::to_value(st).unwrap_or_default();
-            v["newton_iterations_per_step"] =
-                serde_json::json!(if st.steps > 0 { st.newton_iterations as f64 / st.steps as f64 } else { 0.0 });
+            v["newton_iterations_per_step"] = serde_json::json!(if st.steps > 0 {
+                st.newton_iterations as f64 / st.steps as f64
+            } else {
+                0.0
+            });
             v["energy"] = serde_json::json!({ "max_balance_error": self.max_balance });
             v["failure"] = match &r.failure {
                 Some(f) => failure_json(f),
@@ -232,7 +250,11 @@ impl Writer {
 
     /// Writes the final state if it was skipped by `EVERY`, flushes, and rewrites
     /// `summary.json` with the counters and the `complete` flag.
-    pub fn finish(&mut self, integ: &crate::solver::Integrator, report: &RunReport) -> io::Result<()> {
+    pub fn finish(
+        &mut self,
+        integ: &crate::solver::Integrator,
+        report: &RunReport,
+    ) -> io::Result<()> {
         if self.last_row != Some(integ.stats.steps) {
             self.write_state(&Snapshot {
                 integ,

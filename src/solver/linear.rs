@@ -50,10 +50,13 @@ impl SparseSystem {
         }
         let symbolic = {
             let pat = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-            factorize_symbolic_lu(pat, Default::default()).map_err(|e| LinearError::Symbolic(format!("{e:?}")))?
+            factorize_symbolic_lu(pat, Default::default())
+                .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?
         };
-        let factor_mem = MemBuffer::try_new(symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()))
-            .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?;
+        let factor_mem = MemBuffer::try_new(
+            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+        )
+        .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?;
         let solve_mem = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?;
         let nnz = row_idx.len();
@@ -104,7 +107,13 @@ impl SparseSystem {
     /// Numeric LU of the current values, reusing the symbolic factorisation.
     pub fn factor(&mut self) -> Result<(), LinearError> {
         self.factored = false;
-        let pat = SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx);
+        let pat = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
         let mat = SparseColMatRef::new(pat, &self.values);
         self.symbolic
             .factorize_numeric_lu(
@@ -150,7 +159,15 @@ mod tests {
         // [4 1 0; 2 5 1; 0 3 6]
         let cols = vec![vec![0, 1], vec![0, 1, 2], vec![1, 2]];
         let mut s = SparseSystem::new(&cols).unwrap();
-        for (r, c, v) in [(0, 0, 4.0), (1, 0, 2.0), (0, 1, 1.0), (1, 1, 5.0), (2, 1, 3.0), (1, 2, 1.0), (2, 2, 6.0)] {
+        for (r, c, v) in [
+            (0, 0, 4.0),
+            (1, 0, 2.0),
+            (0, 1, 1.0),
+            (1, 1, 5.0),
+            (2, 1, 3.0),
+            (1, 2, 1.0),
+            (2, 2, 6.0),
+        ] {
             let p = s.position(r, c).unwrap();
             s.values[p] = v;
         }

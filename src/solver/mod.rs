@@ -142,12 +142,20 @@ pub enum RunError {
 /// Builds the integrator for a model (initial velocities applied, not yet initialised).
 pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     let sys = System::new(model)?;
-    Ok(match &model.analysis {
+    let mut integ = match &model.analysis {
         Analysis::Dynamic { alpha, newton, .. } => {
             Integrator::new(sys, newton.clone(), *alpha, true)
         }
         Analysis::Static { newton, .. } => Integrator::new(sys, newton.clone(), 0.0, false),
-    })
+    };
+    if integ.dynamic {
+        for iv in &model.initial {
+            if let Some(i) = model.nodes.get_index_of(&iv.node) {
+                integ.set_velocity(i, iv.velocity, iv.angular);
+            }
+        }
+    }
+    Ok(integ)
 }
 
 /// Runs the model's analysis, reporting every accepted state to `obs`.

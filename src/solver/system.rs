@@ -180,7 +180,9 @@ impl System {
                         m.push(if i == NONE || j == NONE {
                             NONE
                         } else {
-                            matrix.position(i as usize, j as usize).map_or(NONE, |p| p as u32)
+                            matrix
+                                .position(i as usize, j as usize)
+                                .map_or(NONE, |p| p as u32)
                         });
                     }
                 }
@@ -214,7 +216,10 @@ impl System {
                 node: index_of(&l.node),
                 moment: l.moment,
                 value: l.value,
-                function: l.function.and_then(|f| model.functions.get(&f)).map(|f| f.function.clone()),
+                function: l
+                    .function
+                    .and_then(|f| model.functions.get(&f))
+                    .map(|f| f.function.clone()),
             })
             .collect();
         let gravity = model.gravity.unwrap_or_else(Vector3::zeros);
@@ -223,16 +228,17 @@ impl System {
             lo = lo.inf(x);
             hi = hi.sup(x);
         }
-        let ref_length = if x0.is_empty() { 1.0 } else { (hi - lo).norm().max(1e-6) };
+        let ref_length = if x0.is_empty() {
+            1.0
+        } else {
+            (hi - lo).norm().max(1e-6)
+        };
         let mut ref_force: f64 = 0.0;
         for l in &loads {
-            let fmax = l
-                .function
-                .as_ref()
-                .map_or(1.0, |f| match f {
-                    Function::Constant(c) => c.abs(),
-                    Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
-                });
+            let fmax = l.function.as_ref().map_or(1.0, |f| match f {
+                Function::Constant(c) => c.abs(),
+                Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
+            });
             let scale = if l.moment { 1.0 / ref_length } else { 1.0 };
             ref_force = ref_force.max(l.value.norm() * fmax * scale);
         }
@@ -272,7 +278,13 @@ impl System {
 
     /// Assembles the global residual into [`System::rhs`] and, when `tangent`, the
     /// iteration matrix into [`System::matrix`]. `lambda` is indexed by global equation.
-    pub fn assemble(&mut self, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64], tangent: bool) -> AssemblyInfo {
+    pub fn assemble(
+        &mut self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+        tangent: bool,
+    ) -> AssemblyInfo {
         self.rhs.iter_mut().for_each(|v| *v = 0.0);
         if tangent {
             self.matrix.clear();
@@ -344,7 +356,11 @@ impl System {
             .map(|l| {
                 let s = &nodes[l.node];
                 let f = l.at(t);
-                if l.moment { f.dot(&(s.r * s.w)) } else { f.dot(&s.v) }
+                if l.moment {
+                    f.dot(&(s.r * s.w))
+                } else {
+                    f.dot(&s.v)
+                }
             })
             .sum()
     }
@@ -353,7 +369,9 @@ impl System {
     pub fn describe(&self, eq: usize) -> String {
         const NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
         match self.owners.get(eq) {
-            Some(DofOwner::Node { node, comp }) => format!("{} {}", self.node_ids[*node], NAMES[*comp]),
+            Some(DofOwner::Node { node, comp }) => {
+                format!("{} {}", self.node_ids[*node], NAMES[*comp])
+            }
             Some(DofOwner::Multiplier { element, k }) => {
                 format!("{} constraint {}", self.elements[*element].id(), k + 1)
             }
