@@ -68,10 +68,8 @@ fn crossings(
         let at = |s: f64| w[0].0 + s * (w[1].0 - w[0].0);
         if t_in.is_none() && g0 >= 0.0 && g1 < 0.0 {
             t_in = Some((at(g0 / (g0 - g1)), w[0].2));
-        } else if let Some((ti, vi)) = t_in {
-            if g0 < 0.0 && g1 >= 0.0 {
-                return (ti, vi, at(g0 / (g0 - g1)), w[1].2);
-            }
+        } else if let Some((ti, vi)) = t_in.filter(|_| g0 < 0.0 && g1 >= 0.0) {
+            return (ti, vi, at(g0 / (g0 - g1)), w[1].2);
         }
     }
     panic!("no complete contact in the history");
@@ -169,4 +167,3 @@ fn sliding_with_friction_stops_at_v0_squared_over_2_mu_g() {
     assert!(last.2.norm() < 1e-3, "stopped");
     assert!((dist - exact).abs() < 0.01 * exact);
 }
-

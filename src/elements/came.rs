@@ -204,10 +204,12 @@ impl Came {
     fn candidate(&self, nodes: &[NodeState]) -> Option<f64> {
         let l = self.local_point(nodes);
         let l2 = Vector2::new(l.x, l.y);
-        if let Some(d) = self.curve.quick_distance(&l2) {
-            if d - self.rho >= 0.0 {
-                return None;
-            }
+        if self
+            .curve
+            .quick_distance(&l2)
+            .is_some_and(|d| d - self.rho >= 0.0)
+        {
+            return None;
         }
         Some(self.curve.closest_parameter(&l2))
     }
@@ -486,12 +488,10 @@ impl Element for Came {
             self.impacts += 1;
         }
         self.active = active;
-        if let Some(st) = &st {
-            if st.gap < 0.0 {
-                self.max_penetration = self.max_penetration.max(-st.gap);
-                if let Some(w) = self.omega_estimate(nodes, st) {
-                    self.omega = w;
-                }
+        if let Some(st) = st.as_ref().filter(|s| s.gap < 0.0) {
+            self.max_penetration = self.max_penetration.max(-st.gap);
+            if let Some(w) = self.omega_estimate(nodes, st) {
+                self.omega = w;
             }
         }
         self.dissipated += 0.5 * (self.last_power + power) * ctx.h;

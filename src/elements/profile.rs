@@ -349,8 +349,9 @@ fn solve_dense(mut a: Vec<Vec<f64>>, mut b: Vec<Vector2<f64>>) -> Vec<Vector2<f6
         for i in k + 1..n {
             let f = a[i][k] / piv;
             if f != 0.0 {
-                for j in k..n {
-                    a[i][j] -= f * a[k][j];
+                let (top, bottom) = a.split_at_mut(i);
+                for (x, y) in bottom[0][k..].iter_mut().zip(&top[k][k..]) {
+                    *x -= f * y;
                 }
                 let bk = b[k];
                 b[i] -= bk * f;
