@@ -558,8 +558,8 @@ impl Element for Joint {
                 let g: f64 = (0..m).map(|i| b[(i, j)] * mu[i]).sum();
                 out.res[Self::local(pair, j)] += g;
             }
-            for i in 0..m {
-                out.res[nn + k * m + i] += s * phi[i];
+            for (i, v) in phi.iter().take(m).enumerate() {
+                out.res[nn + k * m + i] += s * v;
             }
             if let Some(h) = h {
                 for col in 0..12 {
