@@ -130,8 +130,8 @@ impl<const N: usize> Mul for Dual<N> {
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
         let mut eps = [0.0; N];
-        for k in 0..N {
-            eps[k] = self.eps[k] * o.re + self.re * o.eps[k];
+        for ((e, a), b) in eps.iter_mut().zip(&self.eps).zip(&o.eps) {
+            *e = a * o.re + self.re * b;
         }
         Dual {
             re: self.re * o.re,
@@ -146,8 +146,8 @@ impl<const N: usize> Div for Dual<N> {
         let inv = 1.0 / o.re;
         let q = self.re * inv;
         let mut eps = [0.0; N];
-        for k in 0..N {
-            eps[k] = (self.eps[k] - q * o.eps[k]) * inv;
+        for ((e, a), b) in eps.iter_mut().zip(&self.eps).zip(&o.eps) {
+            *e = (a - q * b) * inv;
         }
         Dual { re: q, eps }
     }
@@ -224,8 +224,8 @@ impl<const N: usize> Real for Dual<N> {
         // d atan2(y, x) = (x dy − y dx) / (x² + y²)
         let r2 = x.re * x.re + self.re * self.re;
         let mut eps = [0.0; N];
-        for k in 0..N {
-            eps[k] = (x.re * self.eps[k] - self.re * x.eps[k]) / r2;
+        for ((e, dy), dx) in eps.iter_mut().zip(&self.eps).zip(&x.eps) {
+            *e = (x.re * dy - self.re * dx) / r2;
         }
         Dual {
             re: self.re.atan2(x.re),

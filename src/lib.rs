@@ -4,6 +4,8 @@
 //! (residual, tangent and mass of each element) → [`solver`] (HHT time integration,
 //! Newton, sparse linear algebra) → [`output`] (per-node CSV histories, `summary.json`).
 #![warn(missing_docs)]
+// Numeric kernels index several arrays with one loop index; iterator zips would hide it.
+#![allow(clippy::needless_range_loop)]
 
 pub mod app;
 pub mod deck;

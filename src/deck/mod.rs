@@ -369,4 +369,5 @@ pub fn strip_spans(model: &mut Model) {
     model.functions.values_mut().for_each(|x| x.span = zero);
     model.elements.values_mut().for_each(|x| x.span = zero);
     model.loads.iter_mut().for_each(|x| x.span = zero);
+    model.initial.iter_mut().for_each(|x| x.span = zero);
 }

@@ -242,16 +242,29 @@ impl Element for Beam {
                 let i = Matrix3::identity();
                 let m2 = i * (ctx.c_a * m / 3.0);
                 let m1 = i * (ctx.c_a * m / 6.0);
-                out.add_block(tx(0), tx(0), &m2);
-                out.add_block(tx(1), tx(1), &m2);
-                out.add_block(tx(0), tx(1), &m1);
-                out.add_block(tx(1), tx(0), &m1);
+                out.add_rate_block(tx(0), tx(0), &m2);
+                out.add_rate_block(tx(1), tx(1), &m2);
+                out.add_rate_block(tx(0), tx(1), &m1);
+                out.add_rate_block(tx(1), tx(0), &m1);
                 for (k, s) in [s1, s2].into_iter().enumerate() {
                     let gyro = skew(&s.w) * self.j_node - skew(&(self.j_node * s.w));
-                    out.add_block(rx(k), rx(k), &(self.j_node * ctx.c_a + gyro * ctx.c_v));
+                    out.add_rate_block(rx(k), rx(k), &(self.j_node * ctx.c_a + gyro * ctx.c_v));
                 }
             }
         }
+    }
+
+    fn force_scale(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> f64 {
+        let m = 0.5 * self.translational_mass();
+        let mut f = m * gravity.norm();
+        for &i in &self.nodes {
+            let s = &nodes[i];
+            f = f
+                .max(m * s.a.norm())
+                .max((self.j_node * s.wd).norm())
+                .max(s.w.cross(&(self.j_node * s.w)).norm());
+        }
+        f
     }
 
     fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {

@@ -58,8 +58,17 @@ impl Element for PointMass {
         if tangent {
             out.add_block(tx(0), tx(0), &(Matrix3::identity() * (ctx.c_a * self.mass)));
             let gyro = skew(&s.w) * self.inertia - skew(&jw);
-            out.add_block(rx(0), rx(0), &(self.inertia * ctx.c_a + gyro * ctx.c_v));
+            out.add_rate_block(rx(0), rx(0), &(self.inertia * ctx.c_a + gyro * ctx.c_v));
         }
+    }
+
+    fn force_scale(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> f64 {
+        let s = &nodes[self.node[0]];
+        let jw = self.inertia * s.w;
+        (self.mass * s.a.norm())
+            .max(self.mass * gravity.norm())
+            .max((self.inertia * s.wd).norm())
+            .max(s.w.cross(&jw).norm())
     }
 
     fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {

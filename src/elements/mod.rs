@@ -43,12 +43,21 @@ pub enum BuildError {
 
 /// Builds the solver's elements from a validated model, in model order.
 pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
-    let idx = |id| model.nodes.get_index_of(id).expect("validated model: nodes exist");
+    let idx = |id| {
+        model
+            .nodes
+            .get_index_of(id)
+            .expect("validated model: nodes exist")
+    };
     let mut out: Vec<Box<dyn Element>> = Vec::with_capacity(model.elements.len());
     let mut unsupported = Vec::new();
     for el in model.elements.values() {
         match &el.kind {
-            ElementKind::Beam { material, section, axis2 } => {
+            ElementKind::Beam {
+                material,
+                section,
+                axis2,
+            } => {
                 let mat = &model.materials[material];
                 let sec = &model.sections[section];
                 let (a, b) = (idx(&el.nodes[0]), idx(&el.nodes[1]));
@@ -67,20 +76,41 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                         sec.shear_factor * mat.shear * sec.area,
                         sec.shear_factor * mat.shear * sec.area,
                     ),
-                    cm: Vector3::new(mat.shear * sec.torsion, mat.young * sec.i2, mat.young * sec.i3),
+                    cm: Vector3::new(
+                        mat.shear * sec.torsion,
+                        mat.young * sec.i2,
+                        mat.young * sec.i3,
+                    ),
                     mass: mat.density * sec.area,
                     inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
                 };
-                out.push(Box::new(beam::Beam::new(el.id, [a, b], &x1, &x2, *axis2, props)));
+                out.push(Box::new(beam::Beam::new(
+                    el.id,
+                    [a, b],
+                    &x1,
+                    &x2,
+                    *axis2,
+                    props,
+                )));
             }
             ElementKind::Mass { mass, inertia } => {
-                out.push(Box::new(mass::PointMass::new(el.id, idx(&el.nodes[0]), *mass, *inertia)));
+                out.push(Box::new(mass::PointMass::new(
+                    el.id,
+                    idx(&el.nodes[0]),
+                    *mass,
+                    *inertia,
+                )));
             }
             ElementKind::Came(data) => {
                 let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
                 match came::Came::new(el.id, nodes, data) {
                     Ok(c) => out.push(Box::new(c)),
-                    Err(message) => return Err(BuildError::Invalid { element: el.id, message }),
+                    Err(message) => {
+                        return Err(BuildError::Invalid {
+                            element: el.id,
+                            message,
+                        });
+                    }
                 }
             }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
@@ -174,6 +204,13 @@ pub struct Local {
     pub res: Vec<f64>,
     /// Tangent, column-major `n × n`.
     pub tan: Vec<f64>,
+    /// The part of `tan` that comes from velocities and accelerations
+    /// (`c_v ∂r/∂v + c_a ∂r/∂a`), written by [`Local::add_rate_block`]. The assembler
+    /// multiplies only the rest (the stiffness) by the tangent operator `T(u)` of the
+    /// step's rotation increment, which makes the iteration matrix exact.
+    pub rate: Vec<f64>,
+    /// Whether `rate` holds anything this evaluation.
+    pub has_rate: bool,
 }
 
 impl Local {
@@ -183,6 +220,8 @@ impl Local {
             n,
             res: vec![0.0; n],
             tan: vec![0.0; n * n],
+            rate: vec![0.0; n * n],
+            has_rate: false,
         }
     }
 
@@ -190,6 +229,23 @@ impl Local {
     pub fn clear(&mut self) {
         self.res.iter_mut().for_each(|v| *v = 0.0);
         self.tan.iter_mut().for_each(|v| *v = 0.0);
+        if self.has_rate {
+            self.rate.iter_mut().for_each(|v| *v = 0.0);
+            self.has_rate = false;
+        }
+    }
+
+    /// Adds a 3×3 block of the velocity/acceleration part of the iteration matrix
+    /// (`c_v ∂r/∂v + c_a ∂r/∂a`) at local (row `i`, column `j`): to `tan` and to `rate`.
+    #[inline]
+    pub fn add_rate_block(&mut self, i: usize, j: usize, m: &Matrix3<f64>) {
+        self.has_rate = true;
+        for c in 0..3 {
+            for r in 0..3 {
+                self.tan[(j + c) * self.n + i + r] += m[(r, c)];
+                self.rate[(j + c) * self.n + i + r] += m[(r, c)];
+            }
+        }
     }
 
     /// Adds `v` to the residual at local row `i`.
@@ -275,6 +331,13 @@ pub trait Element: Send + Sync {
         0.0
     }
 
+    /// Magnitude of the separate terms of the element's forces (N or N·m), e.g.
+    /// `max(|m ẍ|, |J Ω̇|, |Ω × JΩ|, |m g|)`: terms that cancel in the residual at
+    /// equilibrium but set the scale Newton's residual is measured against. Default 0.
+    fn force_scale(&self, _nodes: &[NodeState], _gravity: &Vector3<f64>) -> f64 {
+        0.0
+    }
+
     /// Element facts for `summary.json` (e.g. number of impacts of a contact).
     fn summary(&self) -> Option<serde_json::Value> {
         None
@@ -290,7 +353,12 @@ pub trait Element: Send + Sync {
     /// `ctx.h`), asked before the step is committed. `None` = no opinion (the default).
     /// The integrator refuses the step when `ctx.h > accept_up_to` (and retries with
     /// `retry`), and otherwise caps the next step at `next`.
-    fn step_limit(&self, _ctx: &EvalContext, _old: &[NodeState], _new: &[NodeState]) -> Option<StepLimit> {
+    fn step_limit(
+        &self,
+        _ctx: &EvalContext,
+        _old: &[NodeState],
+        _new: &[NodeState],
+    ) -> Option<StepLimit> {
         None
     }
 }
@@ -330,7 +398,10 @@ pub(crate) mod testing {
     impl Lcg {
         /// Uniform in [-1, 1).
         pub fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         }
         /// A vector with components in [-s, s).
@@ -339,7 +410,13 @@ pub(crate) mod testing {
         }
     }
 
-    fn residual(el: &dyn Element, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64], n: usize) -> Vec<f64> {
+    fn residual(
+        el: &dyn Element,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+        n: usize,
+    ) -> Vec<f64> {
         let mut out = Local::new(n);
         el.evaluate(ctx, nodes, lambda, false, &mut out);
         out.res
@@ -347,7 +424,14 @@ pub(crate) mod testing {
 
     /// Perturbs local direction `dir` by `eps` (position/rotation by `eps`, velocity by
     /// `c_v eps`, acceleration by `c_a eps`, multiplier by `eps`).
-    fn perturb(el: &dyn Element, ctx: &EvalContext, nodes: &mut [NodeState], lambda: &mut [f64], dir: usize, eps: f64) {
+    fn perturb(
+        el: &dyn Element,
+        ctx: &EvalContext,
+        nodes: &mut [NodeState],
+        lambda: &mut [f64],
+        dir: usize,
+        eps: f64,
+    ) {
         let nn = el.nodes().len();
         if dir >= 6 * nn {
             lambda[dir - 6 * nn] += eps;
@@ -372,15 +456,28 @@ pub(crate) mod testing {
     /// Asserts that the tangent matches a central difference of the residual, column by
     /// column, to `rel` relative to the largest tangent entry (truncation O(ε²) with
     /// ε = 1e-6 times the state scale, round-off O(1e-16/ε)).
-    pub fn check_tangent(el: &dyn Element, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64], rel: f64) {
+    pub fn check_tangent(
+        el: &dyn Element,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+        rel: f64,
+    ) {
         let n = 6 * el.nodes().len() + el.multipliers();
         let mut out = Local::new(n);
         el.evaluate(ctx, nodes, lambda, true, &mut out);
         let res0 = residual(el, ctx, nodes, lambda, n);
         for (a, b) in out.res.iter().zip(&res0) {
-            assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "residual differs with and without tangent");
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + a.abs()),
+                "residual differs with and without tangent"
+            );
         }
-        let scale = out.tan.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+        let scale = out
+            .tan
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300);
         let eps = 1e-6;
         for col in 0..n {
             let (mut np, mut lp) = (nodes.to_vec(), lambda.to_vec());
@@ -418,7 +515,11 @@ pub(crate) mod testing {
 
     /// Applies a rigid motion `x ↦ Q x + b`, `R ↦ Q R` to the states (velocities rotated;
     /// material angular velocities unchanged).
-    pub fn rigidly_moved(nodes: &[NodeState], q: &Matrix3<f64>, b: &Vector3<f64>) -> Vec<NodeState> {
+    pub fn rigidly_moved(
+        nodes: &[NodeState],
+        q: &Matrix3<f64>,
+        b: &Vector3<f64>,
+    ) -> Vec<NodeState> {
         nodes
             .iter()
             .map(|s| NodeState {

@@ -90,6 +90,7 @@ pub struct Integrator {
     trial_lambda: Vec<f64>,
     delta: Vec<f64>,
     u: Vec<[Vector3<f64>; 2]>,
+    tmap: Vec<nalgebra::Matrix3<f64>>,
 }
 
 /// Outcome of one accepted step.
@@ -117,6 +118,7 @@ impl Integrator {
             trial_lambda: vec![0.0; n],
             delta: vec![0.0; n],
             u: vec![[Vector3::zeros(); 2]; nn],
+            tmap: vec![nalgebra::Matrix3::identity(); nn],
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -195,15 +197,14 @@ impl Integrator {
         self.sys.assemble(&ctx1, &self.nodes, &zero, true);
         let (mut msum, mut ksum, mut kmax, mut cnt) = (0.0, 0.0, 0.0f64, 0usize);
         for eq in 0..nn {
-            if let super::system::DofOwner::Node { comp, .. } = self.sys.owners[eq] {
-                if comp < 3 {
-                    if let Some(p) = self.sys.matrix.position(eq, eq) {
-                        msum += (self.sys.matrix.values[p] - k_vals[p]).abs();
-                        ksum += k_vals[p].abs();
-                        kmax = kmax.max(k_vals[p].abs());
-                        cnt += 1;
-                    }
-                }
+            if let super::system::DofOwner::Node { comp, .. } = self.sys.owners[eq]
+                && comp < 3
+                && let Some(p) = self.sys.matrix.position(eq, eq)
+            {
+                msum += (self.sys.matrix.values[p] - k_vals[p]).abs();
+                ksum += k_vals[p].abs();
+                kmax = kmax.max(k_vals[p].abs());
+                cnt += 1;
             }
         }
         let cnt = cnt.max(1) as f64;
@@ -289,6 +290,7 @@ impl Integrator {
             let t = &mut self.trial[i];
             t.x = s0.x + u_x;
             t.r = s0.r * rotation::exp(&u_r);
+            self.tmap[i] = rotation::tangent(&u_r);
             if self.dynamic {
                 let [a0x, a0r] = self.pseudo[i];
                 let ax = (u_x / (h * h) - s0.v / h - a0x * (0.5 - p.beta)) / p.beta;
@@ -369,9 +371,13 @@ impl Integrator {
         let mut fref = self.sys.ref_force;
         for iter in 0..=self.newton.max_iterations {
             self.trial_from_u(h);
-            let info = self
-                .sys
-                .assemble(&ctx, &self.trial, &self.trial_lambda, true);
+            let info = self.sys.assemble_with(
+                &ctx,
+                &self.trial,
+                &self.trial_lambda,
+                true,
+                Some(&self.tmap),
+            );
             fref = self.sys.ref_force.max(info.force_scale).max(1e-30);
             let rn = self.sys.rhs[..nn]
                 .iter()
@@ -380,7 +386,9 @@ impl Integrator {
                 .iter()
                 .fold(0.0f64, |m, v| m.max(v.abs()))
                 / s_new;
-            let rel = rn / fref.max(self.residual_floor / self.newton.tol_residual);
+            let floor = self.residual_floor
+                + 10.0 * f64::EPSILON * self.sys.ref_length * ctx.c_a * self.mass_ref;
+            let rel = rn / fref.max(floor / self.newton.tol_residual);
             history.push(rel);
             if !rel.is_finite() || !cn.is_finite() {
                 return Err(self.failure(h, FailureReason::NotFinite, history, fref));

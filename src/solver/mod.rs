@@ -212,10 +212,15 @@ pub fn run_prepared(
     while failure.is_none() && integ.t < end - eps {
         let t = integ.t;
         let mut h_try = h.min(end - t).min(integ.step_cap.max(hmin));
-        if let Some(b) = breaks.iter().find(|b| **b > t + eps) {
-            if t + h_try > *b - eps {
-                h_try = *b - t;
-            }
+        if let Some(b) = breaks.iter().find(|b| **b > t + eps)
+            && t + h_try > *b - eps
+        {
+            h_try = *b - t;
+        }
+        // Never leave a sliver of a step before the end (round-off in t would otherwise
+        // ask Newton for a step of 1e-11 s).
+        if end - (t + h_try) < 1e-3 * h_try {
+            h_try = end - t;
         }
         match integ.try_step(h_try) {
             Ok(_) => {

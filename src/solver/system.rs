@@ -5,7 +5,7 @@ use super::linear::{LinearError, SparseSystem};
 use crate::elements::{self, Element, EvalContext, Local, NodeState};
 use crate::model::{Function, Model, NodeId};
 use crate::rotation::skew;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Marks a fixed degree of freedom (no equation).
 pub const FIXED: usize = usize::MAX;
@@ -285,6 +285,21 @@ impl System {
         lambda: &[f64],
         tangent: bool,
     ) -> AssemblyInfo {
+        self.assemble_with(ctx, nodes, lambda, tangent, None)
+    }
+
+    /// As [`System::assemble`], with the tangent operators `T(uᵢ)` of the nodes' rotation
+    /// increments: the stiffness part of each element's rotational columns is multiplied by
+    /// `T(uᵢ)` (since `δΘ = T(u) δu`), so the iteration matrix is the exact derivative with
+    /// respect to the step increment `u` (Brüls, Cardona & Arnold 2012, eq. for `S_t`).
+    pub fn assemble_with(
+        &mut self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+        tangent: bool,
+        tmap: Option<&[Matrix3<f64>]>,
+    ) -> AssemblyInfo {
         self.rhs.iter_mut().for_each(|v| *v = 0.0);
         if tangent {
             self.matrix.clear();
@@ -296,6 +311,9 @@ impl System {
             let k = el.multipliers();
             let o = self.mult_offset[e];
             el.evaluate(ctx, nodes, &lambda[o..o + k], tangent, local);
+            if ctx.dynamic {
+                info.force_scale = info.force_scale.max(el.force_scale(nodes, &ctx.gravity));
+            }
             let rows = &self.rows[e];
             let nn = 6 * el.nodes().len();
             for (i, &g) in rows.iter().enumerate() {
@@ -307,6 +325,9 @@ impl System {
                 }
             }
             if tangent {
+                if let Some(tm) = tmap {
+                    apply_rotation_tangent(local, el.nodes(), tm);
+                }
                 for (p, &pos) in self.maps[e].iter().enumerate() {
                     if pos != NONE {
                         self.matrix.values[pos as usize] += local.tan[p];
@@ -376,6 +397,29 @@ impl System {
                 format!("{} constraint {}", self.elements[*element].id(), k + 1)
             }
             None => format!("equation {eq}"),
+        }
+    }
+}
+
+/// Replaces the rotational columns `K` of a local tangent by `(K − R) T + R`, with `R` the
+/// velocity/acceleration part the element recorded in [`Local::rate`].
+fn apply_rotation_tangent(local: &mut Local, nodes: &[usize], tm: &[Matrix3<f64>]) {
+    let n = local.n;
+    for (k, &node) in nodes.iter().enumerate() {
+        let t = &tm[node];
+        let c0 = 6 * k + 3;
+        for i in 0..n {
+            let mut kk = [0.0; 3];
+            let mut rr = [0.0; 3];
+            for m in 0..3 {
+                let p = (c0 + m) * n + i;
+                rr[m] = if local.has_rate { local.rate[p] } else { 0.0 };
+                kk[m] = local.tan[p] - rr[m];
+            }
+            for j in 0..3 {
+                local.tan[(c0 + j) * n + i] =
+                    kk[0] * t[(0, j)] + kk[1] * t[(1, j)] + kk[2] * t[(2, j)] + rr[j];
+            }
         }
     }
 }
