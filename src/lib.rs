@@ -13,5 +13,6 @@ pub mod dual;
 pub mod elements;
 pub mod model;
 pub mod output;
+pub mod plot;
 pub mod rotation;
 pub mod solver;

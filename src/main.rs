@@ -1,18 +1,31 @@
 //! `mecano-rs`: thin command-line front end; everything lives in the `mecano` library.
 
-use clap::Parser;
+use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// mecano-rs — flexible multibody dynamics from a keyword input deck.
 ///
+/// `mecano-rs DECK` runs a deck; `mecano-rs plot …` draws figures from a run's output.
+///
 /// Exit codes: 0 the run completed; 1 the run failed (diagnosis on standard error,
 /// histories kept and marked incomplete); 2 bad input (deck errors, nothing written).
 #[derive(Parser, Debug)]
-#[command(name = "mecano-rs", version, about, long_about = None)]
+#[command(
+    name = "mecano-rs",
+    version,
+    about,
+    long_about = None,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 struct Cli {
+    /// A subcommand; without one, run the deck.
+    #[command(subcommand)]
+    command: Option<Command>,
     /// The input deck to run (see grammar.md).
-    deck: PathBuf,
+    #[arg(required = true)]
+    deck: Option<PathBuf>,
     /// Output directory (default: the deck's OUTPUT DIR, else out/<deck name>/).
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: Option<PathBuf>,
@@ -25,18 +38,27 @@ struct Cli {
     quiet: bool,
 }
 
+/// Subcommands: one variant each, the logic in the library.
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Draw figures (SVG, PNG, animated GIF) from the output directory of runs.
+    Plot(mecano::plot::PlotArgs),
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let code = if cli.check {
-        mecano::app::check(&cli.deck)
-    } else {
-        mecano::app::run(
-            &cli.deck,
+    let code = match (&cli.command, &cli.deck) {
+        (Some(Command::Plot(args)), _) => mecano::plot::run(args),
+        (None, Some(deck)) if cli.check => mecano::app::check(deck),
+        (None, Some(deck)) => mecano::app::run(
+            deck,
             &mecano::app::RunOptions {
                 out_dir: cli.out,
                 quiet: cli.quiet,
             },
-        )
+        ),
+        // clap requires DECK when no subcommand is given.
+        (None, None) => mecano::app::EXIT_BAD_INPUT,
     };
     ExitCode::from(code)
 }
