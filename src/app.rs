@@ -6,6 +6,7 @@
 use crate::deck;
 use crate::model::Model;
 use crate::output::Writer;
+use crate::output::vtk::{Fanout, VtkWriter};
 use crate::solver::{self, RunReport};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -104,7 +105,18 @@ pub fn run_model(
             ));
         }));
     }
-    let result = solver::run_prepared(model, &mut integ, &mut writer);
+    let mut vtk = if model.output.vtk {
+        Some(
+            VtkWriter::create(dir, model, &integ.sys)
+                .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?,
+        )
+    } else {
+        None
+    };
+    let result = match vtk.as_mut() {
+        Some(v) => solver::run_prepared(model, &mut integ, &mut Fanout(vec![&mut writer, v])),
+        None => solver::run_prepared(model, &mut integ, &mut writer),
+    };
     if let Some(pb) = bar {
         pb.finish_and_clear();
     }
@@ -133,6 +145,10 @@ pub fn run_model(
     writer
         .finish(&integ, &report)
         .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+    if let Some(v) = vtk.as_mut() {
+        v.finish(&integ)
+            .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+    }
     Ok(report)
 }
 

@@ -19,6 +19,8 @@
 //! error. `summary.json` reports its largest positive value relative to
 //! `max(|E(0)|, W_ext, the largest of T, U over the run)`.
 
+pub mod vtk;
+
 use crate::model::{Model, Selection};
 use crate::rotation;
 use crate::solver::{Failure, Observer, RunReport, Snapshot, Stats, System};
