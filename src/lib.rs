@@ -16,3 +16,4 @@ pub mod output;
 pub mod plot;
 pub mod rotation;
 pub mod solver;
+pub mod study;

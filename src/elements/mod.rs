@@ -338,6 +338,12 @@ pub trait Element: Send + Sync {
         0.0
     }
 
+    /// A diagnosis of the element at a state, for the message of a failed step (e.g. a
+    /// universal joint at its singular configuration); `None` = nothing to say (default).
+    fn diagnose(&self, _nodes: &[NodeState]) -> Option<String> {
+        None
+    }
+
     /// Element facts for `summary.json` (e.g. number of impacts of a contact).
     fn summary(&self) -> Option<serde_json::Value> {
         None

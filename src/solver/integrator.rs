@@ -23,6 +23,9 @@ use crate::model::NewtonSettings;
 use crate::rotation;
 use nalgebra::Vector3;
 
+/// Absolute tolerance on constraint equations at convergence (m or rad).
+pub const CONSTRAINT_TOL: f64 = 1e-11;
+
 /// HHT parameters derived from α.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HhtParams {
@@ -82,6 +85,10 @@ pub struct Integrator {
     /// Largest step the elements allow after the last accepted step ([`crate::elements::Element::step_limit`],
     /// e.g. a contact resolving an impact); infinity = no limit.
     pub step_cap: f64,
+    /// Adaptive time stepping (local error tolerances), `None` = fixed steps.
+    pub adaptive: Option<crate::model::Adaptive>,
+    /// Step the local error estimate proposes after the last accepted step (adaptive).
+    pub error_next: f64,
     /// Steps no longer than this are never refused by [`crate::elements::Element::step_limit`] (the run's
     /// smallest step), so a refusal cannot repeat forever.
     pub event_floor: f64,
@@ -131,6 +138,8 @@ impl Integrator {
             external_work: 0.0,
             damping_work: 0.0,
             step_cap: f64::INFINITY,
+            adaptive: None,
+            error_next: f64::INFINITY,
             event_floor: 0.0,
             sys,
         }
@@ -184,6 +193,13 @@ impl Integrator {
     pub fn initialize(&mut self) -> Result<(), Failure> {
         let n = self.sys.n_eq();
         let nn = self.sys.n_node_eq;
+        // An over-constrained mechanism makes every iteration matrix singular: stop at
+        // once, naming the redundant joints.
+        if n > nn
+            && let Some(msg) = crate::elements::joints::redundancy_error(&self.sys, &self.nodes)
+        {
+            return Err(self.failure(0.0, FailureReason::Singular(msg), vec![], self.sys.ref_force));
+        }
         // Stiffness part (c_a = 0), then with c_a = 1: the difference is the mass matrix.
         let ctx0 = EvalContext {
             c_v: 0.0,
@@ -304,6 +320,16 @@ impl Integrator {
         }
     }
 
+    /// What the elements have to say about the last trial state (or, if an element is
+    /// silent on it, the last accepted one), e.g. a universal joint at 90°.
+    fn diagnoses(&self) -> Vec<String> {
+        self.sys
+            .elements
+            .iter()
+            .filter_map(|e| e.diagnose(&self.trial).or_else(|| e.diagnose(&self.nodes)))
+            .collect()
+    }
+
     fn failure(&self, h: f64, reason: FailureReason, history: Vec<f64>, fref: f64) -> Failure {
         // Worst equation of the last assembled residual.
         let (mut worst, mut wv) = (0, 0.0f64);
@@ -330,6 +356,7 @@ impl Integrator {
             },
             worst_value: wv,
             reference_force: fref,
+            diagnoses: self.diagnoses(),
         }
     }
 
@@ -366,7 +393,9 @@ impl Integrator {
         }
         let ctx = self.context(t1, h, s_new);
         let mut history = Vec::new();
-        let tol_len = self.newton.tol_increment * self.sys.ref_length;
+        // Constraint equations are met to an absolute tolerance (m or rad), with a round-off
+        // floor for very large models.
+        let tol_len = CONSTRAINT_TOL.max(100.0 * f64::EPSILON * self.sys.ref_length);
         let mut last_inc = f64::INFINITY;
         let mut fref = self.sys.ref_force;
         for iter in 0..=self.newton.max_iterations {
@@ -397,6 +426,18 @@ impl Integrator {
                 && cn <= tol_len
                 && (iter == 0 || last_inc <= self.newton.tol_increment);
             if converged {
+                if self.dynamic
+                    && let Some(a) = self.adaptive.clone()
+                {
+                    // Local error control before committing (Zienkiewicz & Xie 1991).
+                    let err = self.local_error(h, &a);
+                    let factor = 0.9 * err.max(1e-12).powf(-1.0 / 3.0);
+                    if err > 1.0 && h > self.event_floor * (1.0 + 1e-9) {
+                        let retry = (h * factor.max(0.2)).max(self.event_floor);
+                        return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+                    }
+                    self.error_next = h * factor.min(a.max_growth);
+                }
                 if self.dynamic {
                     // Event control before committing: an element may refuse the step.
                     let (old, new) = (&self.nodes, &self.trial);
@@ -435,7 +476,11 @@ impl Integrator {
             }
             if let Err(e) = self.sys.matrix.factor() {
                 self.stats.factorizations += 1;
-                return Err(self.failure(h, FailureReason::Singular(e.to_string()), history, fref));
+                let why = match crate::elements::joints::redundancy_error(&self.sys, &self.trial) {
+                    Some(r) => format!("{e}; {r}"),
+                    None => e.to_string(),
+                };
+                return Err(self.failure(h, FailureReason::Singular(why), history, fref));
             }
             self.stats.factorizations += 1;
             self.delta.copy_from_slice(&self.sys.rhs);
@@ -513,6 +558,22 @@ impl Integrator {
             el.commit(ctx, &self.nodes, &self.lambda[o..o + k]);
         }
         self.stats.steps += 1;
+    }
+
+    /// Zienkiewicz–Xie local error estimate of the trial step, relative to the tolerances:
+    /// `e = h² |β − 1/6| |ẍ_{n+1} − ẍ_n|` per node for positions (and the same with `Ω̇`
+    /// for rotations), `max(|e_x|/tol_pos, |e_r|/tol_rot)` over the nodes
+    /// (Zienkiewicz & Xie, Earthquake Eng. Struct. Dyn. 20, 1991, eq. 9; the leading term
+    /// of the local truncation error of Newmark-type schemes). ≤ 1 means acceptable.
+    pub fn local_error(&self, h: f64, a: &crate::model::Adaptive) -> f64 {
+        let c = h * h * (self.hht.beta - 1.0 / 6.0).abs();
+        let mut err: f64 = 0.0;
+        for (old, new) in self.nodes.iter().zip(&self.trial) {
+            err = err
+                .max(c * (new.a - old.a).norm() / a.tol_position)
+                .max(c * (new.wd - old.wd).norm() / a.tol_rotation);
+        }
+        err
     }
 
     /// Sum of element energies at the current state.

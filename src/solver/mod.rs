@@ -66,6 +66,9 @@ pub struct Failure {
     pub worst_value: f64,
     /// Reference force used to scale the residual.
     pub reference_force: f64,
+    /// What the elements diagnose at the failed state ([`crate::elements::Element::diagnose`]),
+    /// e.g. a universal joint at its singular configuration.
+    pub diagnoses: Vec<String>,
 }
 
 impl std::fmt::Display for Failure {
@@ -95,7 +98,11 @@ impl std::fmt::Display for Failure {
             f,
             "  largest residual: {} = {:.3e} (reference force {:.3e})",
             self.worst, self.worst_value, self.reference_force
-        )
+        )?;
+        for d in &self.diagnoses {
+            write!(f, "\n  diagnosis: {d}")?;
+        }
+        Ok(())
     }
 }
 
@@ -184,8 +191,11 @@ pub fn run_prepared(
             (1.0, h, h / 1024.0, h)
         }
     };
-    let _ = hmax;
     integ.stats.min_step = f64::INFINITY;
+    if let Analysis::Dynamic { adaptive, .. } = &model.analysis {
+        integ.adaptive = adaptive.clone();
+    }
+    let adaptive = integ.adaptive.is_some();
     integ.event_floor = hmin;
     let mut failure = integ.initialize().err();
     if failure.is_none() {
@@ -236,7 +246,10 @@ pub fn run_prepared(
                 })?;
                 obs.progress(integ.t, end, &integ.stats);
                 good += 1;
-                if h < h0 && good >= 4 {
+                if adaptive {
+                    // The local error estimate proposes the next step.
+                    h = integ.error_next.clamp(hmin, hmax);
+                } else if h < h0 && good >= 4 {
                     h = (2.0 * h).min(h0);
                     good = 0;
                 }

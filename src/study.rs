@@ -1,0 +1,586 @@
+//! Work–precision study: what accuracy costs in time (`mecano-rs study DECK`).
+//!
+//! Runs a deck at a ladder of fixed time steps (and optionally with adaptive tolerances and
+//! other HHT α), takes the finest fixed-step run as the reference, and reports for each run
+//! the CPU seconds, steps, Newton iterations, factorisations and the error of chosen node
+//! histories, **per time window**: positions (m), rotations (rad, `|log(R_refᵀR)|`) and
+//! velocities (m/s), max over the window's sample instants and the chosen nodes. A window
+//! counts as converged when the reference itself is: the difference between the two finest
+//! runs there is at most half the difference between the second and third finest (the
+//! sequence contracts at least like a first-order method) or below 1e-9 m. The
+//! work–precision figure (error against CPU time) uses the converged windows only, as the
+//! IFToMM benchmark protocol compares codes at given precision bands.
+//!
+//! Samples are taken on the grid of the coarsest fixed step (which every fixed run hits);
+//! adaptive runs are interpolated there with cubic Hermite polynomials in position and
+//! velocity (error O(h⁴)) and geodesically in rotation.
+
+use crate::deck::load_deck;
+use crate::model::{Adaptive, Analysis, Model, NodeId};
+use crate::rotation;
+use crate::solver::{self, Observer, Snapshot};
+use nalgebra::{Matrix3, Vector3};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+/// What to study.
+#[derive(Debug, Clone)]
+pub struct StudyOptions {
+    /// Fixed time steps, s (at least 3; the smallest is the reference).
+    pub steps: Vec<f64>,
+    /// Adaptive position tolerances, m (rotation tolerance = position tolerance / m).
+    pub adaptive: Vec<f64>,
+    /// HHT α values of the fixed-step runs (default: the deck's).
+    pub alphas: Vec<f64>,
+    /// User node numbers whose histories are compared (default: the deck's output nodes).
+    pub nodes: Vec<u32>,
+    /// Window length, s.
+    pub window: f64,
+    /// Only study up to this time (default: the deck's end).
+    pub t_max: Option<f64>,
+    /// Where to write study.csv, study_windows.csv and the diagram.
+    pub out_dir: PathBuf,
+}
+
+/// One run of the study.
+#[derive(Debug, Clone)]
+pub struct StudyRun {
+    /// Label, e.g. `h=1.0e-4 a=-0.1` or `adaptive tol=1e-5`.
+    pub label: String,
+    /// Fixed step (or the initial step of an adaptive run), s.
+    pub h: f64,
+    /// HHT α.
+    pub alpha: f64,
+    /// Adaptive position tolerance, m.
+    pub tol: Option<f64>,
+    /// Counters.
+    pub stats: solver::Stats,
+    /// The run reached its end.
+    pub complete: bool,
+    /// Errors per window: (position, rotation, velocity).
+    pub window_errors: Vec<[f64; 3]>,
+    /// Errors over the converged windows: (position, rotation, velocity).
+    pub error: [f64; 3],
+    /// Observed order against the next finer fixed run (fixed runs only).
+    pub order: Option<f64>,
+}
+
+/// The study's result.
+#[derive(Debug, Clone)]
+pub struct StudyReport {
+    /// Runs, coarsest fixed first, then adaptive.
+    pub runs: Vec<StudyRun>,
+    /// Window start times, s.
+    pub windows: Vec<f64>,
+    /// Whether each window's reference is converged.
+    pub converged: Vec<bool>,
+    /// Difference between the two finest runs per window (position, m).
+    pub reference_uncertainty: Vec<f64>,
+}
+
+#[derive(Clone, Copy)]
+struct Rec {
+    t: f64,
+    x: Vector3<f64>,
+    v: Vector3<f64>,
+    r: Matrix3<f64>,
+}
+
+struct Recorder {
+    nodes: Vec<usize>,
+    recs: Vec<Vec<Rec>>,
+}
+
+impl Observer for Recorder {
+    fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
+        let integ = snap.integ;
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let s = &integ.nodes[i];
+            self.recs[k].push(Rec {
+                t: integ.t,
+                x: s.x,
+                v: s.v,
+                r: s.r,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// State of a recorded node at time `t` (Hermite in position, geodesic in rotation).
+fn sample(recs: &[Rec], t: f64) -> Option<Rec> {
+    let k = recs.partition_point(|r| r.t < t - 1e-12);
+    let b = recs.get(k)?;
+    if (b.t - t).abs() <= 1e-12 * t.abs().max(1.0) || k == 0 {
+        return Some(*b);
+    }
+    let a = recs[k - 1];
+    let h = b.t - a.t;
+    let s = (t - a.t) / h;
+    let (h00, h10, h01, h11) = (
+        2.0 * s * s * s - 3.0 * s * s + 1.0,
+        s * s * s - 2.0 * s * s + s,
+        -2.0 * s * s * s + 3.0 * s * s,
+        s * s * s - s * s,
+    );
+    let x = a.x * h00 + a.v * (h10 * h) + b.x * h01 + b.v * (h11 * h);
+    let v = a.v + (b.v - a.v) * s;
+    let r = a.r * rotation::exp(&(rotation::log(&(a.r.transpose() * b.r)) * s));
+    Some(Rec { t, x, v, r })
+}
+
+fn set_run(model: &mut Model, h: f64, alpha: f64, tol: Option<f64>, t_end: f64) {
+    if let Analysis::Dynamic {
+        alpha: a,
+        step,
+        end,
+        min_step,
+        max_step,
+        adaptive,
+        ..
+    } = &mut model.analysis
+    {
+        *a = alpha;
+        *step = h;
+        *end = t_end;
+        *min_step = (h / 1024.0).min(*min_step);
+        *max_step = if tol.is_some() { (*max_step).max(h * 100.0) } else { h };
+        *adaptive = tol.map(|tp| Adaptive {
+            tol_position: tp,
+            tol_rotation: tp,
+            max_growth: 2.0,
+        });
+    }
+}
+
+/// Errors of study runs.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// The deck could not be read.
+    #[error("{0}")]
+    Deck(String),
+    /// The study cannot be set up as asked.
+    #[error("{0}")]
+    Setup(String),
+    /// Writing results failed.
+    #[error(transparent)]
+    Io(#[from] io::Error),
+}
+
+/// Runs the study of the deck at `path`.
+pub fn run_study(path: &Path, opts: &StudyOptions, mut log: impl FnMut(&str)) -> Result<StudyReport, StudyError> {
+    let base = load_deck(path).map_err(|e| StudyError::Deck(format!("{:?}", miette::Report::new(e))))?;
+    let Analysis::Dynamic { alpha, end, .. } = base.analysis else {
+        return Err(StudyError::Setup("a study needs a dynamic analysis".into()));
+    };
+    let mut steps = opts.steps.clone();
+    steps.sort_by(|a, b| b.total_cmp(a));
+    if steps.len() < 3 {
+        return Err(StudyError::Setup("give at least three time steps".into()));
+    }
+    let t_end = opts.t_max.unwrap_or(end).min(end);
+    let node_idx: Vec<usize> = opts
+        .nodes
+        .iter()
+        .map(|n| {
+            base.nodes
+                .get_index_of(&NodeId(*n))
+                .ok_or_else(|| StudyError::Setup(format!("node {n} is not in the deck")))
+        })
+        .collect::<Result<_, _>>()?;
+    if node_idx.is_empty() {
+        return Err(StudyError::Setup("no nodes to compare".into()));
+    }
+    let alphas = if opts.alphas.is_empty() { vec![alpha] } else { opts.alphas.clone() };
+    let mut configs: Vec<(f64, f64, Option<f64>)> = Vec::new();
+    for &a in &alphas {
+        for &h in &steps {
+            configs.push((h, a, None));
+        }
+    }
+    for &tol in &opts.adaptive {
+        configs.push((steps[steps.len() / 2], alphas[0], Some(tol)));
+    }
+    let mut records = Vec::new();
+    let mut runs = Vec::new();
+    for (h, a, tol) in &configs {
+        let mut m = base.clone();
+        set_run(&mut m, *h, *a, *tol, t_end);
+        let label = match tol {
+            None => format!("h={h:.3e} alpha={a}"),
+            Some(t) => format!("adaptive tol={t:.1e} alpha={a}"),
+        };
+        log(&format!("running {label} …"));
+        let mut rec = Recorder {
+            nodes: node_idx.clone(),
+            recs: vec![Vec::new(); node_idx.len()],
+        };
+        let report = solver::run(&m, &mut rec).map_err(|e| StudyError::Setup(e.to_string()))?;
+        runs.push(StudyRun {
+            label,
+            h: *h,
+            alpha: *a,
+            tol: *tol,
+            stats: report.stats,
+            complete: report.failure.is_none(),
+            window_errors: Vec::new(),
+            error: [f64::NAN; 3],
+            order: None,
+        });
+        records.push(rec.recs);
+    }
+    // Sample grid: the coarsest fixed step.
+    let dt = steps[0];
+    let n_samples = (t_end / dt).round() as usize;
+    let nwin = ((t_end / opts.window).ceil() as usize).max(1);
+    let windows: Vec<f64> = (0..nwin).map(|k| k as f64 * opts.window).collect();
+    // Reference: the finest fixed run of the first α.
+    let nfix = steps.len();
+    let ref_i = nfix - 1;
+    let errors_between = |a: usize, b: usize| -> Vec<[f64; 3]> {
+        let mut w = vec![[0.0f64; 3]; nwin];
+        for k in 0..=n_samples {
+            let t = k as f64 * dt;
+            let wi = ((t / opts.window) as usize).min(nwin - 1);
+            for n in 0..node_idx.len() {
+                let (Some(p), Some(q)) = (sample(&records[a][n], t), sample(&records[b][n], t)) else {
+                    // A run that stopped early: its missing samples count as infinite error.
+                    w[wi] = [f64::INFINITY; 3];
+                    continue;
+                };
+                w[wi][0] = w[wi][0].max((p.x - q.x).norm());
+                w[wi][1] = w[wi][1].max(rotation::log(&(q.r.transpose() * p.r)).norm());
+                w[wi][2] = w[wi][2].max((p.v - q.v).norm());
+            }
+        }
+        w
+    };
+    let d01 = errors_between(ref_i, ref_i - 1);
+    let d12 = errors_between(ref_i - 1, ref_i - 2);
+    let reference_uncertainty: Vec<f64> = d01.iter().map(|e| e[0]).collect();
+    let converged: Vec<bool> = (0..nwin).map(|w| d01[w][0] <= 0.5 * d12[w][0] || d01[w][0] < 1e-9).collect();
+    for (i, run) in runs.iter_mut().enumerate() {
+        run.window_errors = if i == ref_i { vec![[0.0; 3]; nwin] } else { errors_between(i, ref_i) };
+        let mut e = [0.0f64; 3];
+        for w in 0..nwin {
+            if converged[w] {
+                for c in 0..3 {
+                    e[c] = e[c].max(run.window_errors[w][c]);
+                }
+            }
+        }
+        run.error = e;
+    }
+    // Observed order between successive fixed runs of the first α, over converged windows.
+    for i in 0..nfix.saturating_sub(2) {
+        let a = errors_between(i, i + 1);
+        let b = errors_between(i + 1, i + 2);
+        let (mut na, mut nb) = (0.0f64, 0.0f64);
+        for w in 0..nwin {
+            if converged[w] {
+                na = na.max(a[w][0]);
+                nb = nb.max(b[w][0]);
+            }
+        }
+        if na > 0.0 && nb > 0.0 {
+            runs[i].order = Some((na / nb).log2() / (steps[i] / steps[i + 1]).log2());
+        }
+    }
+    let report = StudyReport {
+        runs,
+        windows,
+        converged,
+        reference_uncertainty,
+    };
+    write_results(&report, &opts.out_dir)?;
+    Ok(report)
+}
+
+/// Writes `study.csv` (one row per run) and `study_windows.csv` (one row per run and window).
+pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let mut w = csv::Writer::from_path(dir.join("study.csv"))?;
+    w.write_record([
+        "run",
+        "h",
+        "alpha",
+        "adaptive_tol",
+        "cpu_seconds",
+        "steps",
+        "newton_iterations",
+        "factorizations",
+        "rejected_steps",
+        "complete",
+        "error_position",
+        "error_rotation",
+        "error_velocity",
+        "observed_order",
+    ])?;
+    for run in &r.runs {
+        w.write_record([
+            run.label.clone(),
+            format!("{:e}", run.h),
+            run.alpha.to_string(),
+            run.tol.map_or(String::new(), |t| format!("{t:e}")),
+            format!("{:.4}", run.stats.cpu_seconds),
+            run.stats.steps.to_string(),
+            run.stats.newton_iterations.to_string(),
+            run.stats.factorizations.to_string(),
+            run.stats.rejected_steps.to_string(),
+            run.complete.to_string(),
+            format!("{:e}", run.error[0]),
+            format!("{:e}", run.error[1]),
+            format!("{:e}", run.error[2]),
+            run.order.map_or(String::new(), |o| format!("{o:.3}")),
+        ])?;
+    }
+    w.flush()?;
+    let mut w = csv::Writer::from_path(dir.join("study_windows.csv"))?;
+    w.write_record([
+        "run",
+        "window_start",
+        "reference_converged",
+        "reference_uncertainty",
+        "error_position",
+        "error_rotation",
+        "error_velocity",
+    ])?;
+    for run in &r.runs {
+        for (k, t) in r.windows.iter().enumerate() {
+            let e = run.window_errors[k];
+            w.write_record([
+                run.label.clone(),
+                format!("{t}"),
+                r.converged[k].to_string(),
+                format!("{:e}", r.reference_uncertainty[k]),
+                format!("{:e}", e[0]),
+                format!("{:e}", e[1]),
+                format!("{:e}", e[2]),
+            ])?;
+        }
+    }
+    w.flush()
+}
+
+/// Prints the study table.
+pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
+    writeln!(out, "windows (s): reference converged?")?;
+    for (k, t) in r.windows.iter().enumerate() {
+        writeln!(
+            out,
+            "  [{t:6.3}, …)  {}  (finest two runs differ by {:.2e} m)",
+            if r.converged[k] { "converged    " } else { "NOT converged" },
+            r.reference_uncertainty[k]
+        )?;
+    }
+    writeln!(
+        out,
+        "{:<32} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10} {:>10} {:>6}",
+        "run", "CPU s", "steps", "Newton", "factor.", "err x (m)", "err R", "err v", "order"
+    )?;
+    for run in &r.runs {
+        writeln!(
+            out,
+            "{:<32} {:>9.3} {:>8} {:>8} {:>8} {:>10.2e} {:>10.2e} {:>10.2e} {:>6}",
+            run.label,
+            run.stats.cpu_seconds,
+            run.stats.steps,
+            run.stats.newton_iterations,
+            run.stats.factorizations,
+            run.error[0],
+            run.error[1],
+            run.error[2],
+            run.order.map_or("-".into(), |o| format!("{o:.2}")),
+        )?;
+    }
+    Ok(())
+}
+
+/// `mecano-rs study DECK`: arguments.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StudyArgs {
+    /// The deck to study (a dynamic analysis).
+    pub deck: PathBuf,
+    /// Fixed time steps, s, comma-separated (default: the deck's step ×8, ×4, ×2, ×1, ÷2).
+    #[arg(long, value_delimiter = ',')]
+    pub steps: Vec<f64>,
+    /// Adaptive runs: position tolerances, m, comma-separated (rotation tolerance: the same
+    /// number in rad).
+    #[arg(long, value_delimiter = ',')]
+    pub adaptive: Vec<f64>,
+    /// HHT α values of the fixed-step runs, comma-separated (default: the deck's).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub alpha: Vec<f64>,
+    /// Nodes whose histories are compared (default: the deck's OUTPUT nodes).
+    #[arg(long, value_delimiter = ',')]
+    pub nodes: Vec<u32>,
+    /// Window length for the errors, s.
+    #[arg(long, default_value_t = 0.25)]
+    pub window: f64,
+    /// Study only up to this time, s (default: the deck's end time).
+    #[arg(long)]
+    pub until: Option<f64>,
+    /// Output directory (default: out/<deck name>/study).
+    #[arg(short = 'o', long = "out")]
+    pub out: Option<PathBuf>,
+}
+
+/// Runs `mecano-rs study` and returns the exit code (0, or 2 for bad input).
+pub fn run(args: &StudyArgs) -> u8 {
+    let model = match load_deck(&args.deck) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("{:?}", miette::Report::new(e));
+            return crate::app::EXIT_BAD_INPUT;
+        }
+    };
+    let Analysis::Dynamic { step, .. } = model.analysis else {
+        eprintln!("error: {}: a study needs ANALYSIS DYNAMIC", args.deck.display());
+        return crate::app::EXIT_BAD_INPUT;
+    };
+    let steps = if args.steps.is_empty() {
+        [8.0, 4.0, 2.0, 1.0, 0.5].iter().map(|k| step * k).collect()
+    } else {
+        args.steps.clone()
+    };
+    let nodes = if !args.nodes.is_empty() {
+        args.nodes.clone()
+    } else {
+        match &model.output.nodes {
+            crate::model::Selection::List(l) => l.iter().map(|n| n.0).collect(),
+            _ => model.nodes.keys().map(|n| n.0).collect(),
+        }
+    };
+    let out_dir = args.out.clone().unwrap_or_else(|| {
+        crate::app::default_out_dir(&args.deck, &model).join("study")
+    });
+    let opts = StudyOptions {
+        steps,
+        adaptive: args.adaptive.clone(),
+        alphas: args.alpha.clone(),
+        nodes,
+        window: args.window,
+        t_max: args.until,
+        out_dir: out_dir.clone(),
+    };
+    let report = match run_study(&args.deck, &opts, |s| eprintln!("{s}")) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {}: {e}", args.deck.display());
+            return crate::app::EXIT_BAD_INPUT;
+        }
+    };
+    let _ = print_table(&report, &mut io::stdout().lock());
+    for ext in ["svg", "png"] {
+        let file = out_dir.join(format!("work_precision.{ext}"));
+        if let Err(e) = draw_work_precision(&report, &file) {
+            eprintln!("error: {}: {e}", file.display());
+            return crate::app::EXIT_FAILED;
+        }
+    }
+    println!("written: {}/study.csv, study_windows.csv, work_precision.svg/.png", out_dir.display());
+    crate::app::EXIT_OK
+}
+
+/// Draws the work–precision diagram: position error over the converged windows against CPU
+/// seconds, log–log; fixed-step runs joined by a line per α, adaptive runs as another series.
+pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
+    use plotters::prelude::*;
+    crate::plot::ensure_font();
+    // Position error, or the rotation error when the chosen nodes do not translate.
+    let c = usize::from(r.runs.iter().all(|x| x.error[0] == 0.0 || !x.error[0].is_finite()));
+    let pts: Vec<(f64, f64)> = r
+        .runs
+        .iter()
+        .filter(|x| x.error[c] > 0.0 && x.error[c].is_finite() && x.stats.cpu_seconds > 0.0)
+        .map(|x| (x.stats.cpu_seconds, x.error[c]))
+        .collect();
+    if pts.is_empty() {
+        return Err("no run has a measurable error (need at least two fixed steps besides the reference)".into());
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in &pts {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    let ranges = (x0 / 1.5, x1 * 1.5, y0 / 2.0, y1 * 2.0);
+    if let Some(dir) = file.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    }
+    match file.extension().and_then(|e| e.to_str()) {
+        Some("svg") => draw_wp(SVGBackend::new(file, (800, 600)).into_drawing_area(), r, ranges, c),
+        _ => draw_wp(BitMapBackend::new(file, (800, 600)).into_drawing_area(), r, ranges, c),
+    }
+}
+
+fn draw_wp<DB: plotters::prelude::DrawingBackend>(
+    root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    r: &StudyReport,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    c: usize,
+) -> Result<(), String> {
+    use plotters::prelude::*;
+    {
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption("Work-precision (converged windows)", ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("CPU time (s)")
+            .y_desc(if c == 0 { "max position error (m)" } else { "max rotation error (rad)" })
+            .x_label_formatter(&|v| format!("{v:.2e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let mut alphas: Vec<f64> = r.runs.iter().filter(|x| x.tol.is_none()).map(|x| x.alpha).collect();
+        alphas.dedup();
+        let colors = [BLUE, RED, GREEN, MAGENTA];
+        for (k, a) in alphas.iter().enumerate() {
+            let s: Vec<(f64, f64)> = r
+                .runs
+                .iter()
+                .filter(|x| x.tol.is_none() && x.alpha == *a && x.error[c] > 0.0 && x.error[c].is_finite())
+                .map(|x| (x.stats.cpu_seconds, x.error[c]))
+                .collect();
+            let col = colors[k % colors.len()];
+            chart
+                .draw_series(LineSeries::new(s.clone(), col.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(format!("fixed steps, alpha = {a}"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+            chart
+                .draw_series(s.iter().map(|p| Circle::new(*p, 4, col.filled())))
+                .map_err(|e| e.to_string())?;
+        }
+        let ad: Vec<(f64, f64)> = r
+            .runs
+            .iter()
+            .filter(|x| x.tol.is_some() && x.error[c] > 0.0 && x.error[c].is_finite())
+            .map(|x| (x.stats.cpu_seconds, x.error[c]))
+            .collect();
+        if !ad.is_empty() {
+            chart
+                .draw_series(LineSeries::new(ad.clone(), BLACK.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label("adaptive")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+            chart
+                .draw_series(ad.iter().map(|p| TriangleMarker::new(*p, 6, BLACK.filled())))
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())
+    }
+}
