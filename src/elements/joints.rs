@@ -27,10 +27,12 @@
 //! penalty and `λ̂` the element's scaled multipliers (true multipliers `λ = s λ̂`):
 //! nodal rows `Bᵀ(s λ̂ + p Φ)`, multiplier rows `s Φ`; iteration matrix
 //! `[K_g(μ) + p BᵀB, s Bᵀ; s B, 0]` with `μ = sλ̂ + pΦ` and the geometric stiffness
-//! `K_g(μ) = ∂(Bᵀμ)/∂q` at fixed μ. `B` and `K_g` are computed exactly by forward-mode
-//! automatic differentiation of `Φ` (dual and hyper-dual numbers, seeding
-//! `R (I + δΘ̃₁)(I + δΘ̃₂)`: the mixed second derivative is the exact Lie-group one,
-//! `∂²Φ(R exp(ε̃) exp(η̃))/∂ε∂η`), checked against finite differences in the tests.
+//! `K_g(μ) = ∂(Bᵀμ)/∂q` at fixed μ. `Bᵀμ` is written out analytically in the material
+//! spins (`Joint::grad`, generic in the scalar); `B` and `K_g(μ) + p BᵀB` are its exact
+//! derivatives by forward-mode automatic differentiation with the fixed-size
+//! [`Dual<12>`](crate::dual::Dual) (seeding `R (I + δΘ̃)`: `∂[B(R exp(ε̃))ᵀμ]/∂ε` is the exact
+//! Lie-group second derivative `∂²Φ(R exp(ε̃) exp(η̃))/∂ε∂η`), checked against finite
+//! differences in the tests.
 //!
 //! # Outputs (`element_<N>.csv`, reactions in the global frame)
 //! The reaction is the force `F` and moment `M` (about the joint point) that the joint
@@ -57,10 +59,11 @@
 //! solver to append to a failure).
 
 use super::{BuildError, Element, EvalContext, Local, NodeState};
+use crate::dual::{Dual, Real};
 use crate::model::{self, ElementId, ElementKind, Model};
 use crate::rotation::{self, c, skew};
-use nalgebra::{Const, Matrix3, RealField, SMatrix, U1, Vector3};
-use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
+use crate::rotation::{mm, mtm, mtv, mv};
+use nalgebra::{Matrix3, Vector3};
 
 /// `|cos bend|` below which a universal joint is reported singular (bend within ~0.57° of
 /// 90°).
@@ -195,8 +198,13 @@ pub fn is_joint(kind: &ElementKind) -> bool {
     )
 }
 
-type D12 = DualSVec64<12>;
-type H12 = HyperDualSVec64<12, 12>;
+type D12 = Dual<12>;
+
+/// `a·b`, unrolled.
+#[inline(always)]
+fn dot<S: Real>(a: &Vector3<S>, b: &Vector3<S>) -> S {
+    a.x * b.x + a.y * b.y + a.z * b.z
+}
 
 impl Joint {
     /// A joint of type `kind` on dense nodes `nodes` with reference positions `x0`.
@@ -310,7 +318,7 @@ impl Joint {
     }
 
     /// The constraint functions of one pair, generic in the scalar.
-    fn phi<S: RealField + Copy>(
+    fn phi<S: Real>(
         &self,
         pair: &Pair,
         x1: &Vector3<S>,
@@ -319,17 +327,24 @@ impl Joint {
         r2: &Matrix3<S>,
     ) -> [S; 6] {
         let v = |w: &Vector3<f64>| -> Vector3<S> { w.map(c) };
-        let d = x2 + r2 * v(&pair.c2) - x1;
+        let d = x2 + mv(r2, &v(&pair.c2)) - x1;
         let z = S::zero();
-        let rot = || rotation::axial(&(r1.transpose() * r2));
+        let rot = || rotation::axial(&mtm(r1, r2));
         match &self.kind {
             JointType::Spherical => [d.x, d.y, d.z, z, z, z],
             JointType::Hinge { p, q, a } => {
-                let ra = r2 * v(a);
-                [d.x, d.y, d.z, (r1 * v(p)).dot(&ra), (r1 * v(q)).dot(&ra), z]
+                let ra = mv(r2, &v(a));
+                [
+                    d.x,
+                    d.y,
+                    d.z,
+                    dot(&mv(r1, &v(p)), &ra),
+                    dot(&mv(r1, &v(q)), &ra),
+                    z,
+                ]
             }
             JointType::UJoint { a1, a2, .. } => {
-                [d.x, d.y, d.z, (r1 * v(a1)).dot(&(r2 * v(a2))), z, z]
+                [d.x, d.y, d.z, dot(&mv(r1, &v(a1)), &mv(r2, &v(a2))), z, z]
             }
             JointType::Clamp | JointType::Rigid => {
                 let w = rot();
@@ -337,7 +352,14 @@ impl Joint {
             }
             JointType::Prismatic { p, q, .. } => {
                 let w = rot();
-                [w.x, w.y, w.z, (r1 * v(p)).dot(&d), (r1 * v(q)).dot(&d), z]
+                [
+                    w.x,
+                    w.y,
+                    w.z,
+                    dot(&mv(r1, &v(p)), &d),
+                    dot(&mv(r1, &v(q)), &d),
+                    z,
+                ]
             }
         }
     }
@@ -346,90 +368,116 @@ impl Joint {
         self.phi(pair, &s1.x, &s1.r, &s2.x, &s2.r)
     }
 
-    /// `Φ` and `B` (rows = equations, columns = `[δx₁, δΘ₁, δx₂, δΘ₂]`) of one pair.
-    fn jacobian(
+    /// The generalized constraint force `Bᵀμ` of one pair, `[x₁, Θ₁, x₂, Θ₂]` (material
+    /// spins), written out analytically and generic in the scalar. With `Q = R₁ᵀR₂` and the
+    /// variations `δx`, `δR = R δΘ̃`:
+    /// - `d = x₂ + R₂c₂ − x₁`: `δd = δx₂ − δx₁ − R₂ c̃₂ δΘ₂`, so `μ_d` gives
+    ///   `(−μ_d, 0, μ_d, c₂ × R₂ᵀμ_d)`;
+    /// - `(R₁u)·(R₂v)`: `δΘ₁·(u × Qv) + δΘ₂·(v × Qᵀu)`;
+    /// - `(R₁u)·d`: `δΘ₁·(u × R₁ᵀd) + (R₁u)·δd`;
+    /// - `w = axial(skew Q)`: `δQ = −δΘ̃₁Q + QδΘ̃₂` and `axial(ω̃A + Aᵀω̃) = (tr A I − A)ω`
+    ///   give `δw = ½(tr Q I − Qᵀ)δΘ₂ − ½(tr Q I − Q)δΘ₁`.
+    #[allow(clippy::too_many_arguments)]
+    fn grad<S: Real>(
         &self,
         pair: &Pair,
-        s1: &NodeState,
-        s2: &NodeState,
-    ) -> ([f64; 6], SMatrix<f64, 6, 12>) {
-        let seed =
-            |v: f64, k: usize| D12::new(v, Derivative::derivative_generic(Const::<12>, U1, k));
-        let lift = |v: f64| D12::new(v, Derivative::none());
-        let xs = |x: &Vector3<f64>, base: usize| {
-            Vector3::new(seed(x.x, base), seed(x.y, base + 1), seed(x.z, base + 2))
-        };
-        let rs = |r: &Matrix3<f64>, base: usize| {
-            let dth = Vector3::new(seed(0.0, base), seed(0.0, base + 1), seed(0.0, base + 2));
-            let rr: Matrix3<D12> = r.map(lift);
-            rr + rr * skew(&dth)
-        };
-        let f = self.phi(
-            pair,
-            &xs(&s1.x, 0),
-            &rs(&s1.r, 3),
-            &xs(&s2.x, 6),
-            &rs(&s2.r, 9),
-        );
-        let mut phi = [0.0; 6];
-        let mut b = SMatrix::<f64, 6, 12>::zeros();
-        for i in 0..self.m_pair() {
-            phi[i] = f[i].re;
-            if let Some(e) = &f[i].eps.0 {
-                for j in 0..12 {
-                    b[(i, j)] = e[j];
-                }
+        x1: &Vector3<S>,
+        r1: &Matrix3<S>,
+        x2: &Vector3<S>,
+        r2: &Matrix3<S>,
+        mu: &[S; 6],
+    ) -> [S; 12] {
+        let v = |w: &Vector3<f64>| -> Vector3<S> { w.map(c) };
+        let c2 = v(&pair.c2);
+        let q = mtm(r1, r2);
+        let zero = Vector3::<S>::zeros();
+        // Multipliers of `d` (global) and of `axial(skew Q)`, and the dot-product terms.
+        let first = Vector3::new(mu[0], mu[1], mu[2]);
+        let (md, mw, mut gt1, mut gt2) = match &self.kind {
+            JointType::Spherical => (first, None, zero, zero),
+            JointType::Hinge { p, q: qq, a } => {
+                let u = v(p) * mu[3] + v(qq) * mu[4];
+                let a = v(a);
+                (first, None, u.cross(&mv(&q, &a)), a.cross(&mtv(&q, &u)))
             }
+            JointType::UJoint { a1, a2, .. } => {
+                let (u, w) = (v(a1) * mu[3], v(a2));
+                (first, None, u.cross(&mv(&q, &w)), w.cross(&mtv(&q, &u)))
+            }
+            JointType::Clamp | JointType::Rigid => {
+                (first, Some(Vector3::new(mu[3], mu[4], mu[5])), zero, zero)
+            }
+            JointType::Prismatic { p, q: qq, .. } => {
+                let u = v(p) * mu[3] + v(qq) * mu[4];
+                let d = x2 + mv(r2, &c2) - x1;
+                (mv(r1, &u), Some(first), u.cross(&mtv(r1, &d)), zero)
+            }
+        };
+        if let Some(mw) = mw {
+            let tr = q[(0, 0)] + q[(1, 1)] + q[(2, 2)];
+            let h = c::<S>(0.5);
+            gt1 -= (mw * tr - mtv(&q, &mw)) * h;
+            gt2 += (mw * tr - mv(&q, &mw)) * h;
         }
-        (phi, b)
+        gt2 += c2.cross(&mtv(r2, &md));
+        let (gx1, gx2) = (-md, md);
+        [
+            gx1.x, gx1.y, gx1.z, gt1.x, gt1.y, gt1.z, gx2.x, gx2.y, gx2.z, gt2.x, gt2.y, gt2.z,
+        ]
     }
 
-    /// `Φ`, `B` and the second derivatives `H_i(j, k) = ∂²Φ_i/∂ε_j∂η_k` at
-    /// `q ∘ exp(ε) ∘ exp(η)` (hyper-dual numbers).
-    fn hessians(
+    /// `Φ` and `Bᵀμ` of one pair at the nodes' state, `μ = s λ̂ + p Φ`.
+    fn forces_f64(
         &self,
         pair: &Pair,
         s1: &NodeState,
         s2: &NodeState,
-    ) -> ([f64; 6], SMatrix<f64, 6, 12>, Vec<SMatrix<f64, 12, 12>>) {
-        let lift = |v: f64| H12::from_re(v);
+        ctx: &EvalContext,
+        lam: &[f64],
+    ) -> ([f64; 6], [f64; 12]) {
+        let phi = self.phi_f64(pair, s1, s2);
+        let mut mu = [0.0; 6];
+        for (i, m) in mu.iter_mut().enumerate().take(self.m_pair()) {
+            *m = ctx.constraint_scale * lam.get(i).copied().unwrap_or(0.0) + ctx.penalty * phi[i];
+        }
+        (phi, self.grad(pair, &s1.x, &s1.r, &s2.x, &s2.r, &mu))
+    }
+
+    /// `Φ` and `Bᵀμ` of one pair with their exact derivatives along `[δx₁, δΘ₁, δx₂, δΘ₂]`
+    /// (12 dual directions, seeding `R (I + δΘ̃)`): `Φ.eps = B`, and, since `μ = sλ̂ + pΦ`
+    /// is itself dual, `(Bᵀμ).eps = K_g(μ) + p BᵀB`.
+    fn forces_dual(
+        &self,
+        pair: &Pair,
+        s1: &NodeState,
+        s2: &NodeState,
+        ctx: &EvalContext,
+        lam: &[f64],
+    ) -> ([D12; 6], [D12; 12]) {
         let xs = |x: &Vector3<f64>, base: usize| {
-            Vector3::from_fn(|i, _| {
-                H12::from_re(x[i])
-                    .derivative1(base + i)
-                    .derivative2(base + i)
-            })
+            Vector3::new(
+                D12::var(x.x, base),
+                D12::var(x.y, base + 1),
+                D12::var(x.z, base + 2),
+            )
         };
         let rs = |r: &Matrix3<f64>, base: usize| {
-            let d1 = Vector3::from_fn(|i, _| H12::from_re(0.0).derivative1(base + i));
-            let d2 = Vector3::from_fn(|i, _| H12::from_re(0.0).derivative2(base + i));
-            let rr: Matrix3<H12> = r.map(lift);
-            let i3 = Matrix3::<H12>::identity();
-            rr * (i3 + skew(&d1)) * (i3 + skew(&d2))
+            // R (I + δΘ̃): exact to first order, which is all a dual number carries.
+            let dth = Vector3::new(
+                D12::var(0.0, base),
+                D12::var(0.0, base + 1),
+                D12::var(0.0, base + 2),
+            );
+            let rr: Matrix3<D12> = r.map(D12::constant);
+            rr + mm(&rr, &skew(&dth))
         };
-        let f = self.phi(
-            pair,
-            &xs(&s1.x, 0),
-            &rs(&s1.r, 3),
-            &xs(&s2.x, 6),
-            &rs(&s2.r, 9),
-        );
-        let m = self.m_pair();
-        let mut phi = [0.0; 6];
-        let mut b = SMatrix::<f64, 6, 12>::zeros();
-        let mut h = vec![SMatrix::<f64, 12, 12>::zeros(); m];
-        for i in 0..m {
-            phi[i] = f[i].re;
-            if let Some(e) = &f[i].eps1.0 {
-                for j in 0..12 {
-                    b[(i, j)] = e[j];
-                }
-            }
-            if let Some(e) = &f[i].eps1eps2.0 {
-                h[i] = *e;
-            }
+        let (x1, r1, x2, r2) = (xs(&s1.x, 0), rs(&s1.r, 3), xs(&s2.x, 6), rs(&s2.r, 9));
+        let phi = self.phi(pair, &x1, &r1, &x2, &r2);
+        let mut mu = [D12::constant(0.0); 6];
+        for (i, m) in mu.iter_mut().enumerate().take(self.m_pair()) {
+            *m = phi[i] * D12::constant(ctx.penalty) + D12::constant(ctx.constraint_scale * lam[i]);
         }
-        (phi, b, h)
+        (phi, self.grad(pair, &x1, &r1, &x2, &r2, &mu))
     }
 
     /// Local index of entry `j` (0..12) of a pair's `[x₁, Θ₁, x₂, Θ₂]` vector.
@@ -455,15 +503,8 @@ impl Joint {
             .enumerate()
             .map(|(k, pair)| {
                 let (s1, s2) = (&nodes[self.nodes[pair.a]], &nodes[self.nodes[pair.b]]);
-                let (phi, b) = self.jacobian(pair, s1, s2);
-                let mut g = [0.0; 12];
-                for i in 0..m {
-                    let mu = ctx.constraint_scale * lambda.get(k * m + i).copied().unwrap_or(0.0)
-                        + ctx.penalty * phi[i];
-                    for (j, gj) in g.iter_mut().enumerate() {
-                        *gj += b[(i, j)] * mu;
-                    }
-                }
+                let lam = lambda.get(k * m..(k + 1) * m).unwrap_or(&[]);
+                let (_, g) = self.forces_f64(pair, s1, s2, ctx, lam);
                 let f = -Vector3::new(g[6], g[7], g[8]);
                 let mom = s2.r * -Vector3::new(g[9], g[10], g[11]) - (s2.r * pair.c2).cross(&f);
                 (f, mom)
@@ -540,42 +581,37 @@ impl Element for Joint {
         tangent: bool,
         out: &mut Local,
     ) {
-        let (s, pen) = (ctx.constraint_scale, ctx.penalty);
+        let s = ctx.constraint_scale;
         let m = self.m_pair();
         let nn = 6 * self.nodes.len();
         for (k, pair) in self.pairs.iter().enumerate() {
             let (s1, s2) = (&nodes[self.nodes[pair.a]], &nodes[self.nodes[pair.b]]);
             let lam = &lambda[k * m..(k + 1) * m];
-            let (phi, b, h) = if tangent {
-                let (phi, b, h) = self.hessians(pair, s1, s2);
-                (phi, b, Some(h))
-            } else {
-                let (phi, b) = self.jacobian(pair, s1, s2);
-                (phi, b, None)
-            };
-            let mu: Vec<f64> = (0..m).map(|i| s * lam[i] + pen * phi[i]).collect();
-            for j in 0..12 {
-                let g: f64 = (0..m).map(|i| b[(i, j)] * mu[i]).sum();
-                out.res[Self::local(pair, j)] += g;
+            let lrow = nn + k * m;
+            if !tangent {
+                let (phi, g) = self.forces_f64(pair, s1, s2, ctx, lam);
+                for (j, gj) in g.iter().enumerate() {
+                    out.res[Self::local(pair, j)] += gj;
+                }
+                for (i, v) in phi.iter().take(m).enumerate() {
+                    out.res[lrow + i] += s * v;
+                }
+                continue;
+            }
+            let (phi, g) = self.forces_dual(pair, s1, s2, ctx, lam);
+            for (row, gr) in g.iter().enumerate() {
+                let lr = Self::local(pair, row);
+                out.res[lr] += gr.re;
+                for (col, e) in gr.eps.iter().enumerate() {
+                    out.add_tan(lr, Self::local(pair, col), *e);
+                }
             }
             for (i, v) in phi.iter().take(m).enumerate() {
-                out.res[nn + k * m + i] += s * v;
-            }
-            if let Some(h) = h {
-                for col in 0..12 {
+                out.res[lrow + i] += s * v.re;
+                for (col, e) in v.eps.iter().enumerate() {
                     let lc = Self::local(pair, col);
-                    for row in 0..12 {
-                        let mut v = 0.0;
-                        for i in 0..m {
-                            // K(row k, col j) = Σ μᵢ Hᵢ(j, k) + p Σ Bᵢₖ Bᵢⱼ.
-                            v += mu[i] * h[i][(col, row)] + pen * b[(i, row)] * b[(i, col)];
-                        }
-                        out.add_tan(Self::local(pair, row), lc, v);
-                    }
-                    for i in 0..m {
-                        out.add_tan(lc, nn + k * m + i, s * b[(i, col)]);
-                        out.add_tan(nn + k * m + i, lc, s * b[(i, col)]);
-                    }
+                    out.add_tan(lc, lrow + i, s * e);
+                    out.add_tan(lrow + i, lc, s * e);
                 }
             }
         }
