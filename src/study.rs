@@ -144,7 +144,11 @@ fn set_run(model: &mut Model, h: f64, alpha: f64, tol: Option<f64>, t_end: f64) 
         *step = h;
         *end = t_end;
         *min_step = (h / 1024.0).min(*min_step);
-        *max_step = if tol.is_some() { (*max_step).max(h * 100.0) } else { h };
+        *max_step = if tol.is_some() {
+            (*max_step).max(h * 100.0)
+        } else {
+            h
+        };
         *adaptive = tol.map(|tp| Adaptive {
             tol_position: tp,
             tol_rotation: tp,
@@ -168,8 +172,13 @@ pub enum StudyError {
 }
 
 /// Runs the study of the deck at `path`.
-pub fn run_study(path: &Path, opts: &StudyOptions, mut log: impl FnMut(&str)) -> Result<StudyReport, StudyError> {
-    let base = load_deck(path).map_err(|e| StudyError::Deck(format!("{:?}", miette::Report::new(e))))?;
+pub fn run_study(
+    path: &Path,
+    opts: &StudyOptions,
+    mut log: impl FnMut(&str),
+) -> Result<StudyReport, StudyError> {
+    let base =
+        load_deck(path).map_err(|e| StudyError::Deck(format!("{:?}", miette::Report::new(e))))?;
     let Analysis::Dynamic { alpha, end, .. } = base.analysis else {
         return Err(StudyError::Setup("a study needs a dynamic analysis".into()));
     };
@@ -191,7 +200,11 @@ pub fn run_study(path: &Path, opts: &StudyOptions, mut log: impl FnMut(&str)) ->
     if node_idx.is_empty() {
         return Err(StudyError::Setup("no nodes to compare".into()));
     }
-    let alphas = if opts.alphas.is_empty() { vec![alpha] } else { opts.alphas.clone() };
+    let alphas = if opts.alphas.is_empty() {
+        vec![alpha]
+    } else {
+        opts.alphas.clone()
+    };
     let mut configs: Vec<(f64, f64, Option<f64>)> = Vec::new();
     for &a in &alphas {
         for &h in &steps {
@@ -243,7 +256,8 @@ pub fn run_study(path: &Path, opts: &StudyOptions, mut log: impl FnMut(&str)) ->
             let t = k as f64 * dt;
             let wi = ((t / opts.window) as usize).min(nwin - 1);
             for n in 0..node_idx.len() {
-                let (Some(p), Some(q)) = (sample(&records[a][n], t), sample(&records[b][n], t)) else {
+                let (Some(p), Some(q)) = (sample(&records[a][n], t), sample(&records[b][n], t))
+                else {
                     // A run that stopped early: its missing samples count as infinite error.
                     w[wi] = [f64::INFINITY; 3];
                     continue;
@@ -258,9 +272,15 @@ pub fn run_study(path: &Path, opts: &StudyOptions, mut log: impl FnMut(&str)) ->
     let d01 = errors_between(ref_i, ref_i - 1);
     let d12 = errors_between(ref_i - 1, ref_i - 2);
     let reference_uncertainty: Vec<f64> = d01.iter().map(|e| e[0]).collect();
-    let converged: Vec<bool> = (0..nwin).map(|w| d01[w][0] <= 0.5 * d12[w][0] || d01[w][0] < 1e-9).collect();
+    let converged: Vec<bool> = (0..nwin)
+        .map(|w| d01[w][0] <= 0.5 * d12[w][0] || d01[w][0] < 1e-9)
+        .collect();
     for (i, run) in runs.iter_mut().enumerate() {
-        run.window_errors = if i == ref_i { vec![[0.0; 3]; nwin] } else { errors_between(i, ref_i) };
+        run.window_errors = if i == ref_i {
+            vec![[0.0; 3]; nwin]
+        } else {
+            errors_between(i, ref_i)
+        };
         let mut e = [0.0f64; 3];
         for w in 0..nwin {
             if converged[w] {
@@ -369,7 +389,11 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
         writeln!(
             out,
             "  [{t:6.3}, …)  {}  (finest two runs differ by {:.2e} m)",
-            if r.converged[k] { "converged    " } else { "NOT converged" },
+            if r.converged[k] {
+                "converged    "
+            } else {
+                "NOT converged"
+            },
             r.reference_uncertainty[k]
         )?;
     }
@@ -435,7 +459,10 @@ pub fn run(args: &StudyArgs) -> u8 {
         }
     };
     let Analysis::Dynamic { step, .. } = model.analysis else {
-        eprintln!("error: {}: a study needs ANALYSIS DYNAMIC", args.deck.display());
+        eprintln!(
+            "error: {}: a study needs ANALYSIS DYNAMIC",
+            args.deck.display()
+        );
         return crate::app::EXIT_BAD_INPUT;
     };
     let steps = if args.steps.is_empty() {
@@ -451,9 +478,10 @@ pub fn run(args: &StudyArgs) -> u8 {
             _ => model.nodes.keys().map(|n| n.0).collect(),
         }
     };
-    let out_dir = args.out.clone().unwrap_or_else(|| {
-        crate::app::default_out_dir(&args.deck, &model).join("study")
-    });
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| crate::app::default_out_dir(&args.deck, &model).join("study"));
     let opts = StudyOptions {
         steps,
         adaptive: args.adaptive.clone(),
@@ -478,7 +506,10 @@ pub fn run(args: &StudyArgs) -> u8 {
             return crate::app::EXIT_FAILED;
         }
     }
-    println!("written: {}/study.csv, study_windows.csv, work_precision.svg/.png", out_dir.display());
+    println!(
+        "written: {}/study.csv, study_windows.csv, work_precision.svg/.png",
+        out_dir.display()
+    );
     crate::app::EXIT_OK
 }
 
@@ -488,7 +519,11 @@ pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
     use plotters::prelude::*;
     crate::plot::ensure_font();
     // Position error, or the rotation error when the chosen nodes do not translate.
-    let c = usize::from(r.runs.iter().all(|x| x.error[0] == 0.0 || !x.error[0].is_finite()));
+    let c = usize::from(
+        r.runs
+            .iter()
+            .all(|x| x.error[0] == 0.0 || !x.error[0].is_finite()),
+    );
     let pts: Vec<(f64, f64)> = r
         .runs
         .iter()
@@ -496,7 +531,10 @@ pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
         .map(|x| (x.stats.cpu_seconds, x.error[c]))
         .collect();
     if pts.is_empty() {
-        return Err("no run has a measurable error (need at least two fixed steps besides the reference)".into());
+        return Err(
+            "no run has a measurable error (need at least two fixed steps besides the reference)"
+                .into(),
+        );
     }
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for (x, y) in &pts {
@@ -510,8 +548,18 @@ pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
         std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
     }
     match file.extension().and_then(|e| e.to_str()) {
-        Some("svg") => draw_wp(SVGBackend::new(file, (800, 600)).into_drawing_area(), r, ranges, c),
-        _ => draw_wp(BitMapBackend::new(file, (800, 600)).into_drawing_area(), r, ranges, c),
+        Some("svg") => draw_wp(
+            SVGBackend::new(file, (800, 600)).into_drawing_area(),
+            r,
+            ranges,
+            c,
+        ),
+        _ => draw_wp(
+            BitMapBackend::new(file, (800, 600)).into_drawing_area(),
+            r,
+            ranges,
+            c,
+        ),
     }
 }
 
@@ -534,19 +582,30 @@ fn draw_wp<DB: plotters::prelude::DrawingBackend>(
         chart
             .configure_mesh()
             .x_desc("CPU time (s)")
-            .y_desc(if c == 0 { "max position error (m)" } else { "max rotation error (rad)" })
+            .y_desc(if c == 0 {
+                "max position error (m)"
+            } else {
+                "max rotation error (rad)"
+            })
             .x_label_formatter(&|v| format!("{v:.2e}"))
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(|e| e.to_string())?;
-        let mut alphas: Vec<f64> = r.runs.iter().filter(|x| x.tol.is_none()).map(|x| x.alpha).collect();
+        let mut alphas: Vec<f64> = r
+            .runs
+            .iter()
+            .filter(|x| x.tol.is_none())
+            .map(|x| x.alpha)
+            .collect();
         alphas.dedup();
         let colors = [BLUE, RED, GREEN, MAGENTA];
         for (k, a) in alphas.iter().enumerate() {
             let s: Vec<(f64, f64)> = r
                 .runs
                 .iter()
-                .filter(|x| x.tol.is_none() && x.alpha == *a && x.error[c] > 0.0 && x.error[c].is_finite())
+                .filter(|x| {
+                    x.tol.is_none() && x.alpha == *a && x.error[c] > 0.0 && x.error[c].is_finite()
+                })
                 .map(|x| (x.stats.cpu_seconds, x.error[c]))
                 .collect();
             let col = colors[k % colors.len()];
@@ -554,7 +613,9 @@ fn draw_wp<DB: plotters::prelude::DrawingBackend>(
                 .draw_series(LineSeries::new(s.clone(), col.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label(format!("fixed steps, alpha = {a}"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
+                });
             chart
                 .draw_series(s.iter().map(|p| Circle::new(*p, 4, col.filled())))
                 .map_err(|e| e.to_string())?;
@@ -570,9 +631,14 @@ fn draw_wp<DB: plotters::prelude::DrawingBackend>(
                 .draw_series(LineSeries::new(ad.clone(), BLACK.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label("adaptive")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
+                });
             chart
-                .draw_series(ad.iter().map(|p| TriangleMarker::new(*p, 6, BLACK.filled())))
+                .draw_series(
+                    ad.iter()
+                        .map(|p| TriangleMarker::new(*p, 6, BLACK.filled())),
+                )
                 .map_err(|e| e.to_string())?;
         }
         chart

@@ -8,7 +8,12 @@ use mecano::{rotation, solver};
 use std::path::Path;
 
 fn deck(name: &str) -> Model {
-    load_deck(&Path::new(env!("CARGO_MANIFEST_DIR")).join("decks").join(name)).expect("deck parses")
+    load_deck(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("decks")
+            .join(name),
+    )
+    .expect("deck parses")
 }
 
 fn configure(m: &mut Model, h: f64, hmax: f64, tol: Option<f64>) {
@@ -62,15 +67,24 @@ fn adaptive_run_meets_its_tolerance() {
         let rr = r0 * rotation::exp(&(rotation::log(&(r0.transpose() * r1)) * s));
         worst = worst.max(rotation::log(&(rr.transpose() * nodes[0].r)).norm());
     }
-    assert!(worst <= n * tol, "global error {worst:e} above N tol = {:e}", n * tol);
+    assert!(
+        worst <= n * tol,
+        "global error {worst:e} above N tol = {:e}",
+        n * tol
+    );
     assert!(worst > 0.0);
     // A fixed step reaching the same error: error ≈ C h², C from the h = 1e-2 run.
     let mut fixed = deck("free_body.dat");
     configure(&mut fixed, 0.01, 0.01, None);
     let mut f = History::new(1);
     solver::run(&fixed, &mut f).expect("fixed runs");
-    let e_fixed = rotation::log(&(r.nodes.last().unwrap()[0].r.transpose() * f.nodes.last().unwrap()[0].r)).norm();
+    let e_fixed =
+        rotation::log(&(r.nodes.last().unwrap()[0].r.transpose() * f.nodes.last().unwrap()[0].r))
+            .norm();
     let h_needed = 0.01 * (worst / e_fixed).sqrt();
     let steps_needed = 4.0 / h_needed;
-    assert!(n < 1.5 * steps_needed, "adaptive {n} steps vs fixed {steps_needed:.0} for the same error");
+    assert!(
+        n < 1.5 * steps_needed,
+        "adaptive {n} steps vs fixed {steps_needed:.0} for the same error"
+    );
 }
