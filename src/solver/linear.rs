@@ -1,13 +1,14 @@
 //! Sparse iteration matrix and its LU factorisation with faer.
 //!
 //! The sparsity pattern is computed once from the element connectivity; the symbolic LU
-//! (fill-reducing COLAMD ordering, supernodal/simplicial structure) is computed once per
+//! (fill-reducing COLAMD ordering, supernodal structure by default, see [`LuStrategy`]) is computed once per
 //! pattern and reused by every numeric factorisation; the numeric factors, the work space
 //! and the right-hand side live in buffers sized once, so a Newton iteration allocates
 //! nothing once the first factorisation has sized them.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
@@ -20,6 +21,18 @@ pub enum LinearError {
     /// The numeric factorisation failed (singular matrix).
     #[error("the iteration matrix is singular (numeric LU failed: {0})")]
     Singular(String),
+}
+
+/// Which sparse LU faer runs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum LuStrategy {
+    /// faer's choice from the estimated flops per nonzero.
+    #[default]
+    Auto,
+    /// Left-looking simplicial LU (Gilbert–Peierls).
+    Simplicial,
+    /// Supernodal LU (dense blocks).
+    Supernodal,
 }
 
 /// A square sparse matrix with a fixed pattern (compressed sparse columns) and its LU.
@@ -38,8 +51,18 @@ pub struct SparseSystem {
 
 impl SparseSystem {
     /// Builds the pattern from per-column sorted, de-duplicated row lists, and the
-    /// symbolic factorisation.
+    /// symbolic factorisation, supernodal: on the pendulum's iteration matrices (141 to
+    /// 981 equations) faer's supernodal numeric LU took 25–35 % less time than the
+    /// simplicial one it picks by default, for a solve a few µs slower.
     pub fn new(columns: &[Vec<usize>]) -> Result<Self, LinearError> {
+        Self::with_strategy(columns, LuStrategy::Supernodal)
+    }
+
+    /// As [`SparseSystem::new`], with the choice of factorisation.
+    pub fn with_strategy(
+        columns: &[Vec<usize>],
+        strategy: LuStrategy,
+    ) -> Result<Self, LinearError> {
         let n = columns.len();
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
@@ -50,7 +73,15 @@ impl SparseSystem {
         }
         let symbolic = {
             let pat = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-            factorize_symbolic_lu(pat, Default::default())
+            let params = LuSymbolicParams {
+                supernodal_flop_ratio_threshold: match strategy {
+                    LuStrategy::Auto => SupernodalThreshold::AUTO,
+                    LuStrategy::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
+                    LuStrategy::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
+                },
+                ..Default::default()
+            };
+            factorize_symbolic_lu(pat, params)
                 .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?
         };
         let factor_mem = MemBuffer::try_new(
@@ -71,6 +102,13 @@ impl SparseSystem {
             solve_mem,
             factored: false,
         })
+    }
+
+    /// The pattern as per-column row lists (as given to [`SparseSystem::new`]).
+    pub fn columns(&self) -> Vec<Vec<usize>> {
+        (0..self.n)
+            .map(|c| self.row_idx[self.position_range(c)].to_vec())
+            .collect()
     }
 
     /// Dimension.
@@ -178,6 +216,16 @@ mod tests {
         s.solve(&mut b).unwrap();
         for i in 0..3 {
             assert!((b[i] - x[i]).abs() < 1e-14);
+        }
+        // The other factorisations give the same solution.
+        for st in [LuStrategy::Auto, LuStrategy::Simplicial] {
+            let mut t = SparseSystem::with_strategy(&s.columns(), st).unwrap();
+            t.values.copy_from_slice(&s.values);
+            t.factor().unwrap();
+            let mut c = vec![0.0; 3];
+            t.mul(&x, &mut c);
+            t.solve(&mut c).unwrap();
+            assert!(c.iter().zip(&x).all(|(a, b)| (a - b).abs() < 1e-14));
         }
         // New values, same pattern.
         s.values.iter_mut().for_each(|v| *v *= 2.0);
