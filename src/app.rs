@@ -136,7 +136,7 @@ pub fn run_model(
                     worst: format!("output: {e}"),
                     worst_value: 0.0,
                     reference_force: 0.0,
-                    diagnoses: vec![],
+                    diagnoses: Box::default(),
                 }),
             }
         }

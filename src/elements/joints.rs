@@ -687,6 +687,10 @@ impl Element for Joint {
             .fold(0.0, f64::max)
     }
 
+    fn diagnose(&self, nodes: &[NodeState]) -> Option<String> {
+        self.singularity(nodes)
+    }
+
     fn summary(&self) -> Option<serde_json::Value> {
         if !matches!(self.kind, JointType::UJoint { .. }) {
             return None;

@@ -198,7 +198,12 @@ impl Integrator {
         if n > nn
             && let Some(msg) = crate::elements::joints::redundancy_error(&self.sys, &self.nodes)
         {
-            return Err(self.failure(0.0, FailureReason::Singular(msg), vec![], self.sys.ref_force));
+            return Err(self.failure(
+                0.0,
+                FailureReason::Singular(msg),
+                vec![],
+                self.sys.ref_force,
+            ));
         }
         // Stiffness part (c_a = 0), then with c_a = 1: the difference is the mass matrix.
         let ctx0 = EvalContext {
@@ -322,7 +327,7 @@ impl Integrator {
 
     /// What the elements have to say about the last trial state (or, if an element is
     /// silent on it, the last accepted one), e.g. a universal joint at 90°.
-    fn diagnoses(&self) -> Vec<String> {
+    fn diagnoses(&self) -> Box<[String]> {
         self.sys
             .elements
             .iter()

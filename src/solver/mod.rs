@@ -67,8 +67,9 @@ pub struct Failure {
     /// Reference force used to scale the residual.
     pub reference_force: f64,
     /// What the elements diagnose at the failed state ([`crate::elements::Element::diagnose`]),
-    /// e.g. a universal joint at its singular configuration.
-    pub diagnoses: Vec<String>,
+    /// e.g. a universal joint at its singular configuration. (A boxed slice keeps
+    /// `Failure` small: it travels in `Result`s.)
+    pub diagnoses: Box<[String]>,
 }
 
 impl std::fmt::Display for Failure {
