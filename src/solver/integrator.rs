@@ -98,6 +98,9 @@ pub struct Integrator {
     delta: Vec<f64>,
     u: Vec<[Vector3<f64>; 2]>,
     tmap: Vec<nalgebra::Matrix3<f64>>,
+    /// Newton residual history of the step under way (kept between steps so that a
+    /// successful step allocates nothing; handed to the [`Failure`] of a failed one).
+    history: Vec<f64>,
 }
 
 /// Outcome of one accepted step.
@@ -126,6 +129,7 @@ impl Integrator {
             delta: vec![0.0; n],
             u: vec![[Vector3::zeros(); 2]; nn],
             tmap: vec![nalgebra::Matrix3::identity(); nn],
+            history: Vec::with_capacity(newton.max_iterations as usize + 1),
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -397,7 +401,8 @@ impl Integrator {
             };
         }
         let ctx = self.context(t1, h, s_new);
-        let mut history = Vec::new();
+        let mut history = std::mem::take(&mut self.history);
+        history.clear();
         // Constraint equations are met to an absolute tolerance (m or rad), with a round-off
         // floor for very large models.
         let tol_len = CONSTRAINT_TOL.max(100.0 * f64::EPSILON * self.sys.ref_length);
@@ -470,6 +475,7 @@ impl Integrator {
                     self.step_cap = next;
                 }
                 self.accept(h, &ctx);
+                self.history = history;
                 self.stats.newton_iterations += iter as u64;
                 return Ok(StepInfo {
                     iterations: iter,
