@@ -15,5 +15,6 @@ pub mod model;
 pub mod output;
 pub mod plot;
 pub mod rotation;
+pub mod scenes;
 pub mod solver;
 pub mod study;
