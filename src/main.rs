@@ -6,7 +6,8 @@ use std::process::ExitCode;
 
 /// mecano-rs — flexible multibody dynamics from a keyword input deck.
 ///
-/// `mecano-rs DECK` runs a deck; `mecano-rs plot …` draws figures from a run's output.
+/// `mecano-rs DECK` runs a deck; `mecano-rs plot …` draws figures from a run's output;
+/// `mecano-rs study DECK` measures what accuracy costs in time.
 ///
 /// Exit codes: 0 the run completed; 1 the run failed (diagnosis on standard error,
 /// histories kept and marked incomplete); 2 bad input (deck errors, nothing written).
@@ -43,12 +44,17 @@ struct Cli {
 enum Command {
     /// Draw figures (SVG, PNG, animated GIF) from the output directory of runs.
     Plot(mecano::plot::PlotArgs),
+    /// Work-precision study: run a deck at a ladder of time steps (and adaptive tolerances),
+    /// report CPU time, steps, Newton iterations and errors per time window, draw error
+    /// against CPU time.
+    Study(mecano::study::StudyArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let code = match (&cli.command, &cli.deck) {
         (Some(Command::Plot(args)), _) => mecano::plot::run(args),
+        (Some(Command::Study(args)), _) => mecano::study::run(args),
         (None, Some(deck)) if cli.check => mecano::app::check(deck),
         (None, Some(deck)) => mecano::app::run(
             deck,
