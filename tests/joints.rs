@@ -530,3 +530,35 @@ fn universal_joint_at_ninety_degrees_is_diagnosed() {
     assert!(s["singular_passages"].as_u64().unwrap() >= 1, "{s}");
     assert!(s["min_abs_cos_bend"].as_f64().unwrap() < 1e-2, "{s}");
 }
+
+/// Consistent initial multipliers with initial velocities: a pendulum launched at 2 m/s
+/// from the bottom starts with the link tension m(g + v²/L) = 13.81 N. The acceleration-
+/// level constraint includes the velocity term Ḃv, taken by a second difference along the
+/// motion (truncation O(ε²) with ε|v| = 1e-3 L: ~1e-6 relative): 1e-5 m g.
+#[test]
+fn launched_pendulum_starts_with_the_centripetal_tension() {
+    let model = deck("pendulum_launched.dat");
+    let mut integ = mecano::solver::prepare(&model).expect("builds");
+    integ.initialize().expect("initial accelerations");
+    let e = model
+        .elements
+        .get_index_of(&mecano::model::ElementId(1))
+        .unwrap();
+    let ctx = integ.current_context();
+    let lam = integ.sys.element_lambda(e, &integ.lambda).to_vec();
+    let row = integ.sys.elements[e].output_row(&ctx, &integ.nodes, &lam);
+    let header = integ.sys.elements[e].output_header();
+    let fy = row[header.iter().position(|h| h == "fy").expect("fy column")];
+    let exact = 9.81 + 2.0 * 2.0 / 1.0;
+    assert!(
+        (fy - exact).abs() < 1e-5 * 9.81,
+        "tension {fy} N, exact {exact} N"
+    );
+    // And the mass starts with the centripetal acceleration v²/L upward.
+    let i = model.nodes.get_index_of(&mecano::model::NodeId(2)).unwrap();
+    assert!(
+        (integ.nodes[i].a.y - 4.0).abs() < 1e-4,
+        "{}",
+        integ.nodes[i].a
+    );
+}

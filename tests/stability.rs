@@ -257,9 +257,9 @@ fn stiff_contact_runs_and_never_creates_energy() {
 /// (0.068 N where 0.004 N is exact), recorded as an open problem in docs/stability.md;
 /// the others follow the time discretisation.
 ///
-/// (With initial velocities the multipliers start wrong: `initialize` solves for the
-/// accelerations without the velocity terms of the constraints' second derivative, e.g.
-/// the link tension m v²/L, and the error decays only as ρ∞ⁿ; see docs/stability.md.)
+/// (Runs that start with velocities get the constraints' velocity term Ḃv in their
+/// initial multipliers: see `launched_pendulum_starts_with_the_centripetal_tension` in
+/// tests/joints.rs.)
 #[test]
 fn step_range_keeps_iterations_and_multipliers() {
     let (g, l, m) = (9.81, 1.0, 1.0);

@@ -74,6 +74,8 @@ pub struct Integrator {
     pub mass_ref: f64,
     /// Reference stiffness term (mean translational diagonal stiffness), N/m.
     pub stiff_ref: f64,
+    /// Reference rotational inertia (mean rotational diagonal of the mass matrix), kg·m².
+    pub rot_mass_ref: f64,
     /// Round-off floor of the residual, N: `10 ε k_max L_ref`. Positions are known to
     /// `ε |x|`, so a stiffness `k` cannot balance forces better than `ε |x| k`; asking
     /// Newton for less only makes it fail (a stiff bar under a small load).
@@ -139,6 +141,7 @@ impl Integrator {
             mass_ref: 0.0,
             stiff_ref: 0.0,
             residual_floor: 0.0,
+            rot_mass_ref: 0.0,
             external_work: 0.0,
             damping_work: 0.0,
             step_cap: f64::INFINITY,
@@ -221,17 +224,23 @@ impl Integrator {
         let ctx1 = EvalContext { c_a: 1.0, ..ctx0 };
         self.sys.assemble(&ctx1, &self.nodes, &zero, true);
         let (mut msum, mut ksum, mut kmax, mut cnt) = (0.0, 0.0, 0.0f64, 0usize);
+        let (mut jsum, mut jcnt) = (0.0, 0usize);
         for eq in 0..nn {
             if let super::system::DofOwner::Node { comp, .. } = self.sys.owners[eq]
-                && comp < 3
                 && let Some(p) = self.sys.matrix.position(eq, eq)
             {
-                msum += (self.sys.matrix.values[p] - k_vals[p]).abs();
-                ksum += k_vals[p].abs();
-                kmax = kmax.max(k_vals[p].abs());
-                cnt += 1;
+                if comp < 3 {
+                    msum += (self.sys.matrix.values[p] - k_vals[p]).abs();
+                    ksum += k_vals[p].abs();
+                    kmax = kmax.max(k_vals[p].abs());
+                    cnt += 1;
+                } else {
+                    jsum += (self.sys.matrix.values[p] - k_vals[p]).abs();
+                    jcnt += 1;
+                }
             }
         }
+        self.rot_mass_ref = jsum / jcnt.max(1) as f64;
         let cnt = cnt.max(1) as f64;
         self.mass_ref = msum / cnt;
         self.stiff_ref = ksum / cnt;
@@ -267,8 +276,39 @@ impl Integrator {
                 }
             }
         }
-        for r in rhs.iter_mut().skip(nn) {
-            *r = 0.0;
+        // Acceleration-level constraints: s(B v̇ + Ḃv) = 0. The velocity term Ḃv is the
+        // second derivative of Φ along the geodesic q exp(εv) (constant velocities), taken by
+        // a central second difference (truncation O(ε²), ε|v| = 1e-3 L_ref; it is zero for
+        // a start from rest and gives e.g. the centripetal tension of a launched pendulum).
+        let (vmax, wmax) = self.nodes.iter().fold((0.0f64, 0.0f64), |(a, b), s| {
+            (a.max(s.v.norm()), b.max(s.w.norm()))
+        });
+        let mut bdot_v = vec![0.0; n - nn];
+        if n > nn && (vmax > 0.0 || wmax > 0.0) {
+            let eps = (1e-3 * self.sys.ref_length / vmax.max(1e-300)).min(1e-3 / wmax.max(1e-300));
+            let moved = |sign: f64, nodes: &[NodeState]| -> Vec<NodeState> {
+                nodes
+                    .iter()
+                    .map(|s| NodeState {
+                        x: s.x + s.v * (sign * eps),
+                        r: s.r * rotation::exp(&(s.w * (sign * eps))),
+                        ..*s
+                    })
+                    .collect()
+            };
+            let plus = moved(1.0, &self.nodes);
+            let minus = moved(-1.0, &self.nodes);
+            self.sys.assemble(&ctx_s, &self.nodes, &zero, false);
+            let r0: Vec<f64> = self.sys.rhs[nn..].to_vec();
+            self.sys.assemble(&ctx_s, &plus, &zero, false);
+            let rp: Vec<f64> = self.sys.rhs[nn..].to_vec();
+            self.sys.assemble(&ctx_s, &minus, &zero, false);
+            for (k, b) in bdot_v.iter_mut().enumerate() {
+                *b = (rp[k] - 2.0 * r0[k] + self.sys.rhs[nn + k]) / (eps * eps);
+            }
+        }
+        for (r, b) in rhs.iter_mut().skip(nn).zip(&bdot_v) {
+            *r = -b;
         }
         if let Err(e) = self.sys.matrix.factor() {
             return Err(self.failure(
@@ -425,8 +465,13 @@ impl Integrator {
                 .iter()
                 .fold(0.0f64, |m, v| m.max(v.abs()))
                 / s_new;
+            // Round-off of the inertia terms: positions known to ε L_ref, angles to ε rad
+            // (a body spinning exactly about a principal axis has nothing else to scale by).
             let floor = self.residual_floor
-                + 10.0 * f64::EPSILON * self.sys.ref_length * ctx.c_a * self.mass_ref;
+                + 10.0
+                    * f64::EPSILON
+                    * ctx.c_a
+                    * (self.sys.ref_length * self.mass_ref + self.rot_mass_ref);
             let rel = rn / fref.max(floor / self.newton.tol_residual);
             history.push(rel);
             if !rel.is_finite() || !cn.is_finite() {
@@ -444,7 +489,12 @@ impl Integrator {
                     let factor = 0.9 * err.max(1e-12).powf(-1.0 / 3.0);
                     if err > 1.0 && h > self.event_floor * (1.0 + 1e-9) {
                         let retry = (h * factor.max(0.2)).max(self.event_floor);
-                        return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+                        return Err(self.failure(
+                            h,
+                            FailureReason::StepRefused(retry),
+                            history,
+                            fref,
+                        ));
                     }
                     self.error_next = h * factor.min(a.max_growth);
                 }
