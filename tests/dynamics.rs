@@ -4,7 +4,7 @@
 
 use mecano::deck::load_deck;
 use mecano::elements::NodeState;
-use mecano::model::{Analysis, Model, NodeId};
+use mecano::model::{Model, NodeId};
 use mecano::output::History;
 use mecano::rotation;
 use mecano::solver;
@@ -39,24 +39,11 @@ fn idx(model: &Model, node: u32) -> usize {
         .expect("node exists")
 }
 
-fn set_dynamic(model: &mut Model, h: f64, t_end: f64, alpha_new: Option<f64>) {
-    if let Analysis::Dynamic {
-        step,
-        end,
-        min_step,
-        max_step,
-        alpha,
-        ..
-    } = &mut model.analysis
-    {
-        *step = h;
-        *end = t_end;
-        *min_step = h / 1024.0;
-        *max_step = h;
-        if let Some(a) = alpha_new {
-            *alpha = a;
-        }
-    }
+fn set_dynamic(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
+    assert!(
+        model.set_fixed_step(h, t_end, alpha),
+        "dynamic deck expected"
+    );
 }
 
 /// Cantilever roll-up (static): `M₀ = 2πEI/L` bends the beam into a full circle; at

@@ -4,7 +4,7 @@
 //! two 100 s long runs are 60 % of it).
 
 use mecano::deck::load_deck;
-use mecano::model::{Analysis, ElementId, ElementKind, Model, NodeId};
+use mecano::model::{ElementId, ElementKind, Model, NodeId};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::f64::consts::PI;
@@ -17,26 +17,11 @@ fn deck(name: &str) -> Model {
     load_deck(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"))
 }
 
-fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha_new: Option<f64>) {
-    if let Analysis::Dynamic {
-        step,
-        end,
-        min_step,
-        max_step,
-        alpha,
-        ..
-    } = &mut model.analysis
-    {
-        *step = h;
-        *end = t_end;
-        *min_step = h / 1024.0;
-        *max_step = h;
-        if let Some(a) = alpha_new {
-            *alpha = a;
-        }
-    } else {
-        panic!("dynamic deck expected");
-    }
+fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
+    assert!(
+        model.set_fixed_step(h, t_end, alpha),
+        "dynamic deck expected"
+    );
 }
 
 fn set_contact_stiffness(model: &mut Model, k: f64) {

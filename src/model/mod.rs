@@ -416,6 +416,35 @@ impl Default for OutputRequest {
     }
 }
 
+impl Model {
+    /// Switches a dynamic analysis to fixed steps `h` (minimum step `h/1024`) up to `end`,
+    /// with HHT `alpha` if given; returns `false` (and changes nothing) for a static one.
+    /// For studies and tests that rerun a deck at other steps.
+    pub fn set_fixed_step(&mut self, h: f64, end: f64, alpha: Option<f64>) -> bool {
+        let Analysis::Dynamic {
+            step,
+            end: e,
+            min_step,
+            max_step,
+            alpha: a,
+            adaptive,
+            ..
+        } = &mut self.analysis
+        else {
+            return false;
+        };
+        *step = h;
+        *e = end;
+        *min_step = h / 1024.0;
+        *max_step = h;
+        *adaptive = None;
+        if let Some(v) = alpha {
+            *a = v;
+        }
+        true
+    }
+}
+
 /// A validated model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
