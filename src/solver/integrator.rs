@@ -461,10 +461,13 @@ impl Integrator {
             let rn = self.sys.rhs[..nn]
                 .iter()
                 .fold(0.0f64, |m, v| m.max(v.abs()));
-            let cn = self.sys.rhs[nn..]
+            // Constraint rows hold `s Φ`: a force, so they get the force tolerance too
+            // (else a violation of the absolute tolerance, amplified by 1/(βh²) through the
+            // inertia terms, shows up in the multipliers: Cardona & Géradin 1989).
+            let cf = self.sys.rhs[nn..]
                 .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()))
-                / s_new;
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            let cn = cf / s_new;
             // Round-off of the inertia terms: positions known to ε L_ref, angles to ε rad
             // (a body spinning exactly about a principal axis has nothing else to scale by).
             let floor = self.residual_floor
@@ -472,7 +475,8 @@ impl Integrator {
                     * f64::EPSILON
                     * ctx.c_a
                     * (self.sys.ref_length * self.mass_ref + self.rot_mass_ref);
-            let rel = rn / fref.max(floor / self.newton.tol_residual);
+            let fscale = fref.max(floor / self.newton.tol_residual);
+            let rel = rn.max(cf) / fscale;
             history.push(rel);
             if !rel.is_finite() || !cn.is_finite() {
                 return Err(self.failure(h, FailureReason::NotFinite, history, fref));
