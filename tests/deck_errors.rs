@@ -352,6 +352,19 @@ fn malformed_decks_table() {
             2,
             "bad generation `5 TO 5`",
         ),
+        // a typo that would ask for billions of items is an error, not an exhausted memory
+        (
+            format!("{P}NODES\n 3 TO 4294967295 LINE 0 0 0 1 1 1\n{A}"),
+            9,
+            2,
+            "4294967293 items, more than the 1000000",
+        ),
+        (
+            el(" 5 TO 2000000 BEAM 1 2 MAT 1 SEC 1"),
+            9,
+            2,
+            "1999996 items",
+        ),
         (el(" 1 MASS 2 M -1"), 9, 13, "M (mass) = -1 is out of range"),
         (
             el(" 1 CAME 1 2 CAM CIRCLE 0 FOLLOWER POINT K 1"),

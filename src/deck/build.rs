@@ -197,6 +197,27 @@ impl<'t, 'a> Cursor<'t, 'a> {
     }
 }
 
+/// Most items one `a TO b` generation may produce: far beyond any model this solver can
+/// run, and small enough that a typo (`2 TO 4294967295`) is an error, not an exhausted memory.
+pub const MAX_GENERATION: u32 = 1_000_000;
+
+fn generation_size(first: u32, last: u32, span: Span) -> R<()> {
+    if last - first >= MAX_GENERATION {
+        return Err(DeckError::new(
+            K::BadGeneration {
+                first,
+                last,
+                reason: format!(
+                    "{} items, more than the {MAX_GENERATION} one generation may produce",
+                    u64::from(last - first) + 1
+                ),
+            },
+            span,
+        ));
+    }
+    Ok(())
+}
+
 fn out_of_range(what: &str, text: &str, range: &str, span: Span) -> DeckError {
     DeckError::new(
         K::OutOfRange {
@@ -594,6 +615,7 @@ impl<'s> Builder<'s> {
                     Span::new(id_span.start, last_span.end),
                 ));
             }
+            generation_size(id, last, Span::new(id_span.start, last_span.end))?;
             let n = last - id;
             for i in 0..=n {
                 let p = if i == 0 {
@@ -651,6 +673,7 @@ impl<'s> Builder<'s> {
                     Span::new(id_span.start, ls.end),
                 ));
             }
+            generation_size(id, l, Span::new(id_span.start, ls.end))?;
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
@@ -1130,6 +1153,7 @@ impl<'s> Builder<'s> {
                     Span::new(fs.start, last_span.end),
                 ));
             }
+            generation_size(first, last, Span::new(fs.start, last_span.end))?;
         }
         let mut v = Vector3::zeros();
         let mut w = Vector3::zeros();
