@@ -75,6 +75,13 @@ fn crossings(
     panic!("no complete contact in the history");
 }
 
+/// A mass launched at a LINE floor (k = 1e6, m = 1, ζ = 0, 0.1, 0.3, α = 0, 100 steps per
+/// impact): restitution against `exp(−ζπ/√(1−ζ²))` within the trapezoidal rule's derived
+/// bound πζ(ωh)²/4, duration against π/ω_d. The touch is landed on and the dashpot's jump
+/// acts from a restart of the accelerations; the release (CLIP OFF) likewise. Measured
+/// restitution errors 4e-14, 4.5e-5, 1.3e-4 (bounds 1e-9, 7.7e-5, 2.3e-4; before the events
+/// were landed on: 1.6e-3 and 7.9e-3), durations within 8.2e-5 (the linear interpolation of
+/// the crossings in the history).
 #[test]
 fn bouncing_mass_restitution_and_duration() {
     let (k, m, g): (f64, f64, f64) = (1e6, 1.0, 9.81);
@@ -109,7 +116,13 @@ fn bouncing_mass_restitution_and_duration() {
                 (-vi.y - v0).abs() < 2e-2 * v0,
                 "free flight changed the speed"
             );
-            assert!(ee < 0.01, "restitution error {ee}");
+            // Trapezoidal rule (α = 0) on ẏ = λy: ln(amplification) = λh + (λh)³/12 + …, so
+            // over the half period π/ω the log of the amplitude errs by
+            // Re(λ³) h² π/(12 ω) ≈ 3ζω³ h² π/(12 ω) = πζ(ωh)²/4; the steps in contact are
+            // π/(ω n), n = IMPACT_STEPS = 100 (the touch and the release are landed on).
+            let wh = std::f64::consts::PI / 100.0;
+            let bound = std::f64::consts::PI * zeta * wh * wh / 4.0 + 1e-9;
+            assert!(ee <= bound, "restitution error {ee:e} > {bound:e}");
             assert!(ed < 0.02, "duration error {ed}");
             worst = (worst.0.max(ee), worst.1.max(ed));
         }

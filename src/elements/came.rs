@@ -69,9 +69,13 @@ pub const MAX_FLIPS: u32 = 4;
 /// (slack so that the limit, re-estimated at each step, does not make steps chatter).
 pub const LIMIT_SLACK: f64 = 1.5;
 
-/// A step that crosses a contact event should end past it by about this fraction of an
+/// A step that crosses a separation should end past it by about this fraction of an
 /// impact step (and is refused beyond twice that).
 pub const LAND: f64 = 0.02;
+
+/// A step that crosses a touch event is refused unless it ends within this fraction of a
+/// step of the event (it is then *at* the event: see [`Came::step_limit`]).
+pub const EVENT_TOL: f64 = 1e-4;
 
 /// The kinematic and force quantities of a contact at a state.
 #[derive(Debug, Clone, Copy)]
@@ -121,6 +125,15 @@ pub struct Came {
     f_p: Matrix3<f64>,
     // Committed history.
     active: bool,
+    /// The committed state is in contact or exactly at a touch event: the next step uses
+    /// the full law (spring and dashpot). Steps from a state apart use the spring alone,
+    /// so the step that lands on a touch does not feel the dashpot's jump `c q̇_n`.
+    touching: bool,
+    /// Gap (≥ 0) up to which a `touching` contact still counts as closed: the landing
+    /// tolerance of the touch event.
+    touch_tol: f64,
+    /// The last commit switched `touching` on: the integrator restarts its accelerations.
+    restart: bool,
     impacts: u64,
     max_penetration: f64,
     dissipated: f64,
@@ -181,6 +194,9 @@ impl Came {
             rho: radius(&roll.profile).unwrap_or(0.0),
             f_p: roll.frame,
             active: false,
+            touching: false,
+            touch_tol: 0.0,
+            restart: false,
             impacts: 0,
             max_penetration: 0.0,
             dissipated: 0.0,
@@ -226,6 +242,7 @@ impl Came {
         w: [Vector3<S>; 2],
         eta0: f64,
         force_on: bool,
+        damped: bool,
     ) -> ContactState<S> {
         let (si, pi) = (self.s, 1 - self.s);
         let (xs, rs, vs, ws) = (x[si], r[si], v[si], r[si] * w[si]);
@@ -242,7 +259,8 @@ impl Came {
         let gap = pr.normal.dot(&(Vector2::new(l.x, l.y) - pr.point)) - rho;
         let pdot = vp + wp.cross(&arm_p);
         let gap_rate = n.dot(&(pdot - vs - ws.cross(&(p - xs))));
-        let force = -(c::<S>(self.k) * gap + c::<S>(self.c) * gap_rate);
+        let c_n = if damped { self.c } else { 0.0 };
+        let force = -(c::<S>(self.k) * gap + c::<S>(c_n) * gap_rate);
         let on_surface = p - n * (gap + rho);
         let on_roller = p - n * rho;
         let mid = (on_surface + on_roller) * c::<S>(0.5);
@@ -281,11 +299,27 @@ impl Came {
         }
     }
 
-    /// The contact state at `nodes` in f64 (`None` when certainly apart).
+    /// The contact state at `nodes` in f64 (`None` when certainly apart), with the force
+    /// law of the step that starts from the committed state (see `touching`).
     pub fn state(&self, nodes: &[NodeState]) -> Option<ContactState<f64>> {
-        let eta0 = self.candidate(nodes)?;
+        let eta0 = match self.candidate(nodes) {
+            Some(e) => e,
+            None if self.touching => {
+                let l = self.local_point(nodes);
+                self.curve.closest_parameter(&Vector2::new(l.x, l.y))
+            }
+            None => return None,
+        };
         let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
-        let st = self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false);
+        let st = self.kernel(
+            [a.x, b.x],
+            [a.r, b.r],
+            [a.v, b.v],
+            [a.w, b.w],
+            eta0,
+            false,
+            self.touching,
+        );
         Some(st)
     }
 
@@ -294,12 +328,37 @@ impl Came {
         let l = self.local_point(nodes);
         let eta0 = self.curve.closest_parameter(&Vector2::new(l.x, l.y));
         let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
-        self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false)
+        self.kernel(
+            [a.x, b.x],
+            [a.r, b.r],
+            [a.v, b.v],
+            [a.w, b.w],
+            eta0,
+            false,
+            true,
+        )
+    }
+
+    /// Whether the contact is closed at a state: penetrating, or within the landing
+    /// tolerance of a touch event the committed state sits on.
+    fn closed(&self, st: &ContactState<f64>) -> bool {
+        st.gap < 0.0 || (self.touching && st.gap <= self.touch_tol)
+    }
+
+    /// Gap tolerance of a touch event: the event time is met within [`EVENT_TOL`] of the
+    /// step `h` (or of the impact step if shorter), i.e. `EVENT_TOL · h · |q̇_n|`.
+    fn touch_tolerance(&self, h: f64, gap_rate: f64) -> f64 {
+        let h_imp = if self.omega > 0.0 {
+            std::f64::consts::PI / (self.omega * f64::from(self.impact_steps))
+        } else {
+            f64::INFINITY
+        };
+        EVENT_TOL * h.min(h_imp) * gap_rate.abs()
     }
 
     /// The normal force actually applied (compressive, N) for a contact state.
     fn applied(&self, st: &ContactState<f64>) -> f64 {
-        if st.gap >= 0.0 {
+        if !self.closed(st) {
             0.0
         } else if self.clip {
             st.force.max(0.0)
@@ -332,7 +391,7 @@ impl Came {
 
     /// Dissipated power (dashpot, clipped spring energy, friction) at a contact state.
     fn power(&self, st: &ContactState<f64>) -> f64 {
-        if st.gap >= 0.0 {
+        if !self.closed(st) {
             return 0.0;
         }
         let p = self.applied(st);
@@ -386,21 +445,39 @@ impl Element for Came {
         let eta0 = match self.candidate(nodes) {
             Some(e) => e,
             // Apart: nothing to compute, unless the active set is frozen in contact.
-            None if !self.active_flag(ctx, false) => return,
+            None if !self.touching && !self.active_flag(ctx, false) => return,
             None => {
                 let l = self.local_point(nodes);
                 self.curve.closest_parameter(&Vector2::new(l.x, l.y))
             }
         };
         let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
-        let st = self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false);
-        let active = self.active_flag(ctx, st.gap < 0.0);
+        let damped = self.touching;
+        let st = self.kernel(
+            [a.x, b.x],
+            [a.r, b.r],
+            [a.v, b.v],
+            [a.w, b.w],
+            eta0,
+            false,
+            damped,
+        );
+        let closed = st.gap < 0.0 || (self.touching && st.gap <= self.touch_tol);
+        let active = self.active_flag(ctx, closed);
         let force_on = active && (!self.clip || st.force > 0.0);
         if !force_on {
             return;
         }
         if !tangent {
-            let st = self.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, true);
+            let st = self.kernel(
+                [a.x, b.x],
+                [a.r, b.r],
+                [a.v, b.v],
+                [a.w, b.w],
+                eta0,
+                true,
+                damped,
+            );
             for (blk, v) in st.res.iter().enumerate() {
                 out.add_res(3 * blk, v);
             }
@@ -451,6 +528,7 @@ impl Element for Came {
             [vs(&a.w, 3), vs(&b.w, 9)],
             eta0,
             true,
+            damped,
         );
         let n = out.n;
         for (blk, v) in st.res.iter().enumerate() {
@@ -479,11 +557,27 @@ impl Element for Came {
     }
 
     fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {
+        // Dissipation over the step, with the law the step used.
+        let power = self.state(nodes).map_or(0.0, |st| self.power(&st));
+        self.dissipated += 0.5 * (self.last_power + power) * ctx.h;
+        // Touch event: a state apart within the landing tolerance of the surface and
+        // approaching it is *at* the event; from there the full law acts, and the
+        // integrator restarts its accelerations with it (one-sided limits of the force).
+        let was = self.touching;
+        if ctx.dynamic {
+            let fs = self.full_state(nodes);
+            let tol = self.touch_tolerance(ctx.h, fs.gap_rate);
+            self.touching = fs.gap < 0.0 || (fs.gap <= tol && fs.gap_rate < 0.0);
+            self.touch_tol = if self.touching { tol } else { 0.0 };
+        } else {
+            self.touching = self.state(nodes).is_some_and(|st| st.gap < 0.0);
+            self.touch_tol = 0.0;
+        }
+        self.restart = ctx.dynamic && self.touching != was;
         let st = self.state(nodes);
-        let (active, power) = match &st {
-            Some(st) => (st.gap < 0.0 && self.applied(st) != 0.0, self.power(st)),
-            None => (false, 0.0),
-        };
+        let active = st
+            .as_ref()
+            .is_some_and(|st| self.closed(st) && self.applied(st) != 0.0);
         if active && !self.active {
             self.impacts += 1;
         }
@@ -494,8 +588,15 @@ impl Element for Came {
                 self.omega = w;
             }
         }
-        self.dissipated += 0.5 * (self.last_power + power) * ctx.h;
-        self.last_power = power;
+        self.last_power = if self.restart && self.touching {
+            st.map_or(0.0, |st| self.power(&st))
+        } else {
+            power
+        };
+    }
+
+    fn restart(&self) -> bool {
+        self.restart
     }
 
     fn output_header(&self) -> Vec<String> {
@@ -543,6 +644,16 @@ impl Element for Came {
         self.state(nodes).map_or(0.0, |st| self.power(&st))
     }
 
+    /// Event control. **Touch** (apart at the start, penetrating at the end): the step is
+    /// refused unless it ends within the landing tolerance of the event
+    /// ([`EVENT_TOL`] of a step), and retried with the event time found by cubic Hermite
+    /// interpolation of the gap between the two ends (the end state is computed with the
+    /// spring alone, so it is close to the free flight). A step that lands is *at* the
+    /// event: the dashpot's force jump acts from the next step on, after the integrator
+    /// restarted its accelerations ([`Element::restart`]) — the step never straddles the
+    /// jump, and the impact is resolved at the order of the scheme. **In contact**: steps
+    /// no longer than `π/(ω · impact_steps)`. **Separation**: the step ends just past it.
+    /// A step that jumped over a whole impact is refused.
     fn step_limit(
         &self,
         ctx: &EvalContext,
@@ -551,7 +662,8 @@ impl Element for Came {
     ) -> Option<StepLimit> {
         let h = ctx.h;
         let (st0, st1) = (self.full_state(old), self.full_state(new));
-        let (in0, in1) = (st0.gap < 0.0, st1.gap < 0.0);
+        let in0 = self.touching;
+        let in1 = self.closed(&st1);
         if let Some(w) = Some(st1)
             .filter(|_| in1)
             .and_then(|s| self.omega_estimate(new, &s))
@@ -569,12 +681,14 @@ impl Element for Came {
             f64::INFINITY
         };
         let land = if h_imp.is_finite() { LAND * h_imp } else { 0.0 };
-        // Linear estimates of the time to the next event (contact or separation) from a state.
+        // Estimates of the time to the next event (contact or separation) from a state.
         let time_to_event = |st: &ContactState<f64>, nodes: &[NodeState]| -> Option<f64> {
             if st.gap >= 0.0 {
-                return (st.gap_rate < 0.0).then(|| st.gap / -st.gap_rate);
+                // Quadratic in time with the gap acceleration (gravity bends the approach).
+                let acc = self.gap_acceleration(nodes, &st.normal);
+                return first_root(st.gap, st.gap_rate, acc);
             }
-            let mut t = (st.gap_rate > 0.0).then(|| -st.gap / st.gap_rate);
+            let mut t = (st.gap_rate > 0.0).then(|| -st.gap / st.gap_rate + land.max(0.0));
             if self.clip {
                 let p = -(self.k * st.gap + self.c * st.gap_rate);
                 let pdot =
@@ -592,36 +706,51 @@ impl Element for Came {
                 next: retry,
             })
         };
-        let retry_from_old = || match time_to_event(&st0, old) {
-            Some(t) if t < h => t + land.max(1e-3 * t),
-            _ => h / 4.0,
-        };
-        if in0 != in1 {
-            // The contact state changed inside the step: the step must land just past the
-            // event, i.e. spend no more than a small part of an impact beyond it.
-            // Linear estimate of the time since the event, backwards from the end.
+        if !in0 && st1.gap < 0.0 {
+            // Touch inside the step: land on it, or retry at its interpolated time.
+            let tol = self.touch_tolerance(h, st1.gap_rate);
+            if -st1.gap > tol {
+                let tau = hermite_root(st0.gap, st0.gap_rate, st1.gap, st1.gap_rate, h);
+                return refuse(tau.unwrap_or(0.5 * h).min(h_imp));
+            }
+        } else if in0 && !in1 && !self.clip {
+            // Separation inside the step without clipping: the dashpot's pull `c q̇_n` drops
+            // to zero there, a jump like the touch's: land on it (within the tolerance
+            // the touch was landed with) or retry at its interpolated time.
+            let tau = hermite_root(-st0.gap.min(0.0), -st0.gap_rate, -st1.gap, -st1.gap_rate, h);
+            return refuse(tau.unwrap_or(0.5 * h).min(h_imp));
+        } else if in0 && !in1 {
+            // Separation inside the step (the clipped force is already zero there, only its
+            // slope jumps): land just past it.
             let past = if st1.gap_rate == 0.0 {
                 0.0
             } else {
                 (st1.gap / st1.gap_rate).abs()
             };
             if h_imp.is_finite() && past > 2.0 * LAND * h_imp + 1e-12 {
-                return refuse(retry_from_old().min(h_imp));
+                let retry = match time_to_event(&st0, old) {
+                    Some(t) if t < h => t,
+                    _ => h / 4.0,
+                };
+                return refuse(retry.min(h_imp));
             }
-        } else if !in1 {
+        } else if !in0 && !in1 {
             // Apart at both ends: did the step jump over a whole impact?
-            let (s0, s1) = (st0, st1);
-            if s0.gap_rate < 0.0 && s1.gap_rate > 0.0 && s0.gap + s0.gap_rate * h < 0.0 {
-                return refuse(retry_from_old().min(h_imp));
+            if st0.gap_rate < 0.0 && st1.gap_rate > 0.0 && st0.gap + st0.gap_rate * h < 0.0 {
+                let retry = match time_to_event(&st0, old) {
+                    Some(t) if t < h => t,
+                    _ => h / 4.0,
+                };
+                return refuse(retry.min(h_imp));
             }
         } else if h > LIMIT_SLACK * h_imp {
             return refuse(h_imp);
         }
         // Accepted: cap the next step at the impact resolution and at the next event.
-        let st = st1;
-        let mut next = if in1 { h_imp } else { f64::INFINITY };
-        if let Some(t) = time_to_event(&st, new) {
-            next = next.min(t + land.max(1e-3 * t));
+        let closed_next = in1 || st1.gap < 0.0;
+        let mut next = if closed_next { h_imp } else { f64::INFINITY };
+        if let Some(t) = time_to_event(&st1, new) {
+            next = next.min(t);
         }
         next.is_finite().then_some(StepLimit {
             accept_up_to: f64::INFINITY,
@@ -629,6 +758,50 @@ impl Element for Came {
             next,
         })
     }
+}
+
+/// Smallest positive root of `g + ġ τ + ½ g̈ τ²` (the time a gap closes), if any.
+fn first_root(g: f64, gd: f64, gdd: f64) -> Option<f64> {
+    let (a, b, c) = (0.5 * gdd, gd, g);
+    if a == 0.0 {
+        return (b < 0.0).then(|| -c / b);
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    // Stable forms of the two roots.
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let roots = [q / a, if q != 0.0 { c / q } else { f64::NAN }];
+    roots
+        .into_iter()
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .min_by(f64::total_cmp)
+}
+
+/// The time in `(0, h)` where the cubic Hermite interpolant of a gap through
+/// `(0, g0, ġ0)` and `(h, g1, ġ1)` vanishes (`g0 ≥ 0 > g1`), by bisection.
+fn hermite_root(g0: f64, gd0: f64, g1: f64, gd1: f64, h: f64) -> Option<f64> {
+    if !(g0 >= 0.0 && g1 < 0.0 && h > 0.0) {
+        return None;
+    }
+    let p = |s: f64| {
+        let (s2, s3) = (s * s, s * s * s);
+        (2.0 * s3 - 3.0 * s2 + 1.0) * g0
+            + (s3 - 2.0 * s2 + s) * h * gd0
+            + (-2.0 * s3 + 3.0 * s2) * g1
+            + (s3 - s2) * h * gd1
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if p(mid) >= 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi) * h)
 }
 
 impl Came {
@@ -649,7 +822,7 @@ impl Came {
             )
         };
         let _ = n_c;
-        let active = if st.gap < 0.0 && p != 0.0 { 1.0 } else { 0.0 };
+        let active = if p != 0.0 { 1.0 } else { 0.0 };
         vec![
             active,
             st.gap,
@@ -716,7 +889,15 @@ mod tests {
                 let l = el.local_point(&st);
                 let eta0 = el.curve.closest_parameter(&Vector2::new(l.x, l.y));
                 let (a, b) = (&st[0], &st[1]);
-                Some(el.kernel([a.x, b.x], [a.r, b.r], [a.v, b.v], [a.w, b.w], eta0, false))
+                Some(el.kernel(
+                    [a.x, b.x],
+                    [a.r, b.r],
+                    [a.v, b.v],
+                    [a.w, b.w],
+                    eta0,
+                    false,
+                    true,
+                ))
             });
             let s = s.unwrap();
             let pi = 1 - el.s;
@@ -726,15 +907,28 @@ mod tests {
     }
 
     fn check(cam: Profile, fol: Profile, mu: f64, clip: bool) {
-        let el = Came::new(ElementId(1), [0, 1], &data(cam, fol, mu, clip)).unwrap();
+        // Both laws: from a state apart (spring alone) and in contact (spring and dashpot).
+        for touching in [false, true] {
+            let mut el = Came::new(
+                ElementId(1),
+                [0, 1],
+                &data(cam.clone(), fol.clone(), mu, clip),
+            )
+            .unwrap();
+            el.touching = touching;
+            check_law(&el, clip);
+        }
+    }
+
+    fn check_law(el: &Came, clip: bool) {
         for seed in 1..6 {
-            let st = state_in_contact(&el, seed, 1e-3);
+            let st = state_in_contact(el, seed, 1e-3);
             let s = el.state(&st).unwrap();
             assert!((s.gap + 1e-3).abs() < 1e-9, "gap {}", s.gap);
             if clip && s.force <= 0.0 {
                 continue;
             }
-            check_tangent(&el, &dyn_ctx(), &st, &[], 1e-6);
+            check_tangent(el, &dyn_ctx(), &st, &[], 1e-6);
         }
     }
 

@@ -355,6 +355,14 @@ pub trait Element: Send + Sync {
         0.0
     }
 
+    /// Whether the last [`Element::commit`] switched the element's force law
+    /// discontinuously (a contact's dashpot acting from a touch event on): the integrator
+    /// then recomputes consistent accelerations at the committed state, as at `t = 0`,
+    /// so that no step straddles the jump. Default: never.
+    fn restart(&self) -> bool {
+        false
+    }
+
     /// Event (impact) control of a converged trial step from `old` to `new` (step
     /// `ctx.h`), asked before the step is committed. `None` = no opinion (the default).
     /// The integrator refuses the step when `ctx.h > accept_up_to` (and retries with

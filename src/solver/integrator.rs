@@ -252,6 +252,31 @@ impl Integrator {
             self.scale = self.scale_for(0.0);
             return Ok(());
         }
+        self.consistent_accelerations()
+    }
+
+    /// Consistent accelerations and multipliers at the current state, from the equations
+    /// of motion `[M  sBᵀ; sB  0] [v̇; λ̂] = [−r(q, v, 0); −s Ḃv]`; the pseudo-accelerations
+    /// restart from them (`a = v̇`). Used at `t = 0` and after an element switched its force
+    /// law ([`crate::elements::Element::restart`]): a restart costs one local error of
+    /// `O(h²)` in the velocities, which keeps the scheme second-order, while a step across
+    /// the jump would cost `O(h)`.
+    pub fn consistent_accelerations(&mut self) -> Result<(), Failure> {
+        let n = self.sys.n_eq();
+        let nn = self.sys.n_node_eq;
+        let ctx0 = EvalContext {
+            c_v: 0.0,
+            c_a: 0.0,
+            ..self.context(self.t, 0.0, 1.0)
+        };
+        let ctx1 = EvalContext { c_a: 1.0, ..ctx0 };
+        let zero = vec![0.0; n];
+        // The residual's inertia terms use the nodes' accelerations: clear them, so that
+        // the solution is the acceleration itself, not a correction to it.
+        for s in &mut self.nodes {
+            s.a = Vector3::zeros();
+            s.wd = Vector3::zeros();
+        }
         self.scale = self.scale_for(0.0).max(self.mass_ref);
         // Build [M, sBᵀ; sB, 0] from the two assemblies.
         let s = self.scale;
@@ -518,7 +543,7 @@ impl Integrator {
                         }
                     }
                     if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
-                        let retry = retry.max(self.event_floor).min(0.5 * h);
+                        let retry = retry.max(self.event_floor).min(0.999 * h);
                         return Err(self.failure(
                             h,
                             FailureReason::StepRefused(retry),
@@ -623,6 +648,13 @@ impl Integrator {
             el.commit(ctx, &self.nodes, &self.lambda[o..o + k]);
         }
         self.stats.steps += 1;
+        if self.dynamic && self.sys.elements.iter().any(|e| e.restart()) {
+            // The same matrix factored at t = 0: if it fails now, the accelerations of
+            // the step are kept (a valid start, one order less accurate across the jump).
+            if self.consistent_accelerations().is_ok() {
+                self.stats.restarts += 1;
+            }
+        }
     }
 
     /// Zienkiewicz–Xie local error estimate of the trial step, relative to the tolerances:

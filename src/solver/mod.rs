@@ -25,6 +25,8 @@ pub struct Stats {
     pub factorizations: u64,
     /// Rejected (cut) step attempts.
     pub rejected_steps: u64,
+    /// Restarts of the accelerations at events (e.g. contact touches).
+    pub restarts: u64,
     /// Smallest step used, s.
     pub min_step: f64,
     /// Largest step used, s.
@@ -220,9 +222,32 @@ pub fn run_prepared(
     let mut h = h0;
     let mut good = 0u32;
     let eps = 1e-9 * h0;
+    // A step an element asked for after refusing one (an event's time): tried once, the
+    // nominal step `h` stays as it was.
+    let mut retry: Option<f64> = None;
     while failure.is_none() && integ.t < end - eps {
         let t = integ.t;
-        let mut h_try = h.min(end - t).min(integ.step_cap.max(hmin));
+        let mut h_try = retry
+            .take()
+            .unwrap_or(h)
+            .min(end - t)
+            .min(integ.step_cap.max(hmin));
+        if !adaptive {
+            // Fixed steps come back to the grid t = k h₀ after an event moved them off it,
+            // so that histories keep their sampling times.
+            // (t is a sum of steps: "on the grid" within round-off, and never a sliver.)
+            let k = (t / h0).round();
+            let next_grid = if (t - k * h0).abs() <= 1e-6 * h0 {
+                (k + 1.0) * h0
+            } else {
+                (t / h0).ceil() * h0
+            };
+            let mut to_grid = next_grid - t;
+            if to_grid < 1e-3 * h0 {
+                to_grid += h0;
+            }
+            h_try = h_try.min(to_grid);
+        }
         if let Some(b) = breaks.iter().find(|b| **b > t + eps)
             && t + h_try > *b - eps
         {
@@ -261,8 +286,7 @@ pub fn run_prepared(
             }) => {
                 // An element (e.g. a contact at an impact) asks for a shorter step.
                 integ.stats.rejected_steps += 1;
-                good = 0;
-                h = h_ok.max(hmin).min(h_try);
+                retry = Some(h_ok.max(hmin).min(h_try));
             }
             Err(f) => {
                 integ.stats.rejected_steps += 1;
