@@ -95,8 +95,9 @@ fn max_of(v: &[f64]) -> f64 {
 
 /// The rigid case (10 beams per bar, E = 2.1e15) converges at the same step as steel
 /// (h = 1e-4 s, through the torque pulse and the first impact, 0.6 s), with no cut step
-/// and a bounded number of Newton iterations (≤ 4 per step on average; measured 2.11 steel,
-/// 1.20 rigid beams, 1.18 RIGID bodies), and its tip follows the RIGID-body variant
+/// and a bounded Newton effort: ≤ 4 matrix factorisations per step on average and ≤ 14
+/// (modified) Newton iterations (a contraction of at least 4 per iteration from a residual
+/// ≤ 1 to the 1e-8 tolerance; figures printed), and its tip follows the RIGID-body variant
 /// (`decks/pendulum_rigid_body.dat`; skipped, with a message, if that deck is absent) to
 /// within 1e-3 m (measured 3.1e-5 m over 0.6 s).
 #[test]
@@ -124,14 +125,16 @@ fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
         );
         assert!(r.failure.is_none(), "{d}: {}", r.failure.unwrap());
         let it = it_per_step(&r);
+        let fact = r.stats.factorizations as f64 / r.stats.steps.max(1) as f64;
         println!(
-            "{d}: {} steps, {} cut, {it:.2} it/step, max violation {:.1e}, {:.1} s",
+            "{d}: {} steps, {} cut, {it:.2} it/step, {fact:.2} factorisations/step, max violation {:.1e}, {:.1} s",
             r.stats.steps,
             r.stats.rejected_steps,
             max_of(&rec.viol),
             r.stats.cpu_seconds
         );
-        assert!(it <= 4.0, "{d}: {it} iterations per step");
+        assert!(it <= 14.0, "{d}: {it} iterations per step");
+        assert!(fact <= 4.0, "{d}: {fact} factorisations per step");
         let traj: Vec<(f64, Vector3<f64>)> = rec
             .t
             .iter()
@@ -404,6 +407,132 @@ fn free_body_about_the_intermediate_axis_conserves_energy_and_momentum() {
     );
     assert!(de < 1e-4 && dl < 1e-4, "drifts {de:e}, {dl:e}");
     assert!(flips >= 2, "the body should flip");
+}
+
+/// Energy, angular momentum about the origin and body-frame spin flips of the flexible
+/// racket (`decks/stab_racket_beam.dat`), accumulated step by step (250,000 states).
+struct RacketBeam {
+    /// Per BEAM: node indices, translational mass ρ A L_e, nodal rotary inertia (material).
+    beams: Vec<([usize; 2], f64, Vector3<f64>)>,
+    /// Per MASS: node, rotary inertia (material frame = global at t = 0).
+    masses: Vec<(usize, Matrix3<f64>)>,
+    centre: usize,
+    e0: f64,
+    l0: Vector3<f64>,
+    de: f64,
+    dl: f64,
+    flips: usize,
+    last_spin: f64,
+}
+
+impl RacketBeam {
+    fn new(model: &Model) -> Self {
+        let mut beams = Vec::new();
+        let mut masses = Vec::new();
+        for el in model.elements.values() {
+            match &el.kind {
+                ElementKind::Beam {
+                    material, section, ..
+                } => {
+                    let (m, s) = (&model.materials[material], &model.sections[section]);
+                    let n = [node(model, el.nodes[0].0), node(model, el.nodes[1].0)];
+                    let le = (model.nodes[n[1]].position - model.nodes[n[0]].position).norm();
+                    let rho = m.density;
+                    beams.push((
+                        n,
+                        rho * s.area * le,
+                        Vector3::new(rho * (s.i2 + s.i3), rho * s.i2, rho * s.i3) * (0.5 * le),
+                    ));
+                }
+                ElementKind::Mass { inertia, .. } => {
+                    masses.push((node(model, el.nodes[0].0), *inertia));
+                }
+                _ => {}
+            }
+        }
+        RacketBeam {
+            beams,
+            masses,
+            centre: node(model, 3),
+            e0: f64::NAN,
+            l0: Vector3::zeros(),
+            de: 0.0,
+            dl: 0.0,
+            flips: 0,
+            last_spin: 0.0,
+        }
+    }
+
+    /// `L = Σ_beams m/6 (2 x₁×v₁ + x₁×v₂ + x₂×v₁ + 2 x₂×v₂)` (the consistent linear mass)
+    /// `+ Σ R J Ω` (the lumped rotary inertias and the MASS).
+    fn momentum(&self, nodes: &[mecano::elements::NodeState]) -> Vector3<f64> {
+        let mut l = Vector3::zeros();
+        for (n, m, j) in &self.beams {
+            let (a, b) = (&nodes[n[0]], &nodes[n[1]]);
+            l +=
+                (a.x.cross(&a.v) * 2.0 + a.x.cross(&b.v) + b.x.cross(&a.v) + b.x.cross(&b.v) * 2.0)
+                    * (m / 6.0);
+            for s in [a, b] {
+                l += s.r * j.component_mul(&s.w);
+            }
+        }
+        for (n, j) in &self.masses {
+            let s = &nodes[*n];
+            l += s.r * (j * s.w);
+        }
+        l
+    }
+}
+
+impl Observer for RacketBeam {
+    fn state(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let i = snap.integ;
+        let en = i.energies();
+        let e = en.kinetic + en.strain;
+        let l = self.momentum(&i.nodes);
+        if self.e0.is_nan() {
+            (self.e0, self.l0) = (e, l);
+        }
+        self.de = self.de.max((e - self.e0).abs() / self.e0);
+        self.dl = self.dl.max((l - self.l0).norm() / self.l0.norm());
+        let spin = i.nodes[self.centre].w.y;
+        if spin * self.last_spin < 0.0 {
+            self.flips += 1;
+        }
+        self.last_spin = spin;
+        Ok(())
+    }
+}
+
+/// A free *flexible* beam spinning about its intermediate principal axis
+/// (`decks/stab_racket_beam.dat`: 4 BEAMs and a MASS, principal inertias 0.15, 2.58, 3.58
+/// kg m²; spin 2π rad/s, perturbed by 0.01 rad/s): 50 turns with α = 0 at h = 2e-4 s, the
+/// step that resolves every mode of the mesh (ωh < 0.3, see the deck): energy (kinetic +
+/// strain) and the angular momentum vector are conserved within 1e-4 relative, and the bar
+/// does flip (the body-frame spin of its centre node about Y reverses), with no singularity.
+/// Measured: energy 1.5e-6, angular momentum (below), 250,000 steps, 3.0 it/step.
+#[test]
+fn flexible_beam_about_the_intermediate_axis_conserves_energy_and_momentum() {
+    let model = deck("stab_racket_beam.dat");
+    let mut obs = RacketBeam::new(&model);
+    let r = solver::run(&model, &mut obs).expect("run starts");
+    assert!(r.failure.is_none(), "{}", r.failure.unwrap());
+    println!(
+        "racket beam: {} steps, {:.2} it/step, {:.1} s CPU; energy drift {:.2e}, angular momentum drift {:.2e}, {} flips",
+        r.stats.steps,
+        it_per_step(&r),
+        r.stats.cpu_seconds,
+        obs.de,
+        obs.dl,
+        obs.flips
+    );
+    assert!(
+        obs.de < 1e-4 && obs.dl < 1e-4,
+        "drifts {:e}, {:e}",
+        obs.de,
+        obs.dl
+    );
+    assert!(obs.flips >= 2, "the bar should flip");
 }
 
 // ---------------------------------------------------------------- numerical damping

@@ -10,9 +10,16 @@
 //!
 //! For rotations `∘ exp` is `R_{n+1} = R_n exp(ũ)`, so orientations never pass through a
 //! parametrisation singularity. The unknown of Newton's method is `u` (and the scaled
-//! multipliers): `∂v/∂u = γ/(βh)`, `∂v̇/∂u = 1/((1−α_f)βh²)`; the iteration matrix
-//! neglects `T(u) − I = O(h)` in the rotational columns of the stiffness (as Brüls et al.
-//! allow), which slows nothing measurable and keeps the matrix assembly element-local.
+//! multipliers): `∂v/∂u = γ/(βh)`, `∂v̇/∂u = 1/((1−α_f)βh²)`, and the rotational columns of
+//! the stiffness carry the tangent map `T(u)` of the exponential (exact iteration matrix).
+//!
+//! Newton is *modified* (the matrix is kept, also from one step to the next of the same
+//! size, while each iteration divides the residual by at least 1/[`CONTRACTION`]; then only
+//! residuals are assembled, which for the beams skips the dual-number tangent, and the LU
+//! is reused), and an iterate reached with a kept matrix is polished until the residual
+//! stagnates, so the converged states equal full Newton's (2.5e-8 m on the rigid pendulum
+//! after 0.3 s, where h vs h/2 differ by 1.5e-7 m). On the pendulum this makes a step
+//! 5.4× cheaper (81 µs instead of 440 µs).
 //! The scheme is second-order accurate and, for linear problems, has HHT's spectral radius
 //! at infinity `ρ∞ = (1 + α)/(1 − α)`.
 
@@ -25,6 +32,10 @@ use nalgebra::Vector3;
 
 /// Absolute tolerance on constraint equations at convergence (m or rad).
 pub const CONSTRAINT_TOL: f64 = 1e-11;
+
+/// Modified Newton keeps its iteration matrix while each iteration divides the relative
+/// residual by at least 1/CONTRACTION.
+pub const CONTRACTION: f64 = 0.25;
 
 /// HHT parameters derived from α.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,6 +105,9 @@ pub struct Integrator {
     /// Steps no longer than this are never refused by [`crate::elements::Element::step_limit`] (the run's
     /// smallest step), so a refusal cannot repeat forever.
     pub event_floor: f64,
+    /// Step size the numeric LU in `sys.matrix` was computed for (NaN = none valid): a later
+    /// step of the same size starts from it (modified Newton).
+    lu_step: f64,
     trial: Vec<NodeState>,
     trial_pseudo: Vec<[Vector3<f64>; 2]>,
     trial_lambda: Vec<f64>,
@@ -122,6 +136,7 @@ impl Integrator {
         let n = sys.n_eq();
         let nn = nodes.len();
         Integrator {
+            lu_step: f64::NAN,
             trial: nodes.clone(),
             nodes,
             pseudo: vec![[Vector3::zeros(); 2]; nn],
@@ -335,6 +350,7 @@ impl Integrator {
         for (r, b) in rhs.iter_mut().skip(nn).zip(&bdot_v) {
             *r = -b;
         }
+        self.lu_step = f64::NAN;
         if let Err(e) = self.sys.matrix.factor() {
             return Err(self.failure(
                 0.0,
@@ -473,13 +489,21 @@ impl Integrator {
         let tol_len = CONSTRAINT_TOL.max(100.0 * f64::EPSILON * self.sys.ref_length);
         let mut last_inc = f64::INFINITY;
         let mut fref = self.sys.ref_force;
+        // Modified Newton: the iteration matrix factored for an earlier iterate (of this
+        // step, or of a previous step of the same size) is kept while the residual contracts
+        // by at least CONTRACTION per iteration; otherwise it is rebuilt at the current
+        // iterate. Iterations without a rebuild assemble the residual alone.
+        let mut tangent = self.lu_step != h;
+        let mut prev_rel = f64::INFINITY;
+        // Whether the last solve used a matrix built at the iterate it started from.
+        let mut fresh = false;
         for iter in 0..=self.newton.max_iterations {
             self.trial_from_u(h);
-            let info = self.sys.assemble_with(
+            let mut info = self.sys.assemble_with(
                 &ctx,
                 &self.trial,
                 &self.trial_lambda,
-                true,
+                tangent,
                 Some(&self.tmap),
             );
             fref = self.sys.ref_force.max(info.force_scale).max(1e-30);
@@ -506,9 +530,20 @@ impl Integrator {
             if !rel.is_finite() || !cn.is_finite() {
                 return Err(self.failure(h, FailureReason::NotFinite, history, fref));
             }
+            // After a solve with a kept matrix the iterate's error is ~ρ/(1−ρ) of the last
+            // increment, not ~its square as after a Newton step: iterate on while the
+            // residual still falls (each such iteration is one residual and one solve), so
+            // the result is as accurate as full Newton's (the rigid pendulum drifts by
+            // 4e-5 m in 0.3 s otherwise: residuals at the round-off floor of stiff bars hide
+            // 1e-10 m errors in the mechanism's directions, which add up step after step).
+            let polished = iter == 0
+                || fresh
+                || rel <= 0.01 * self.newton.tol_residual
+                || rel > 0.5 * prev_rel;
             let converged = rel <= self.newton.tol_residual
                 && cn <= tol_len
-                && (iter == 0 || last_inc <= self.newton.tol_increment);
+                && (iter == 0 || last_inc <= self.newton.tol_increment)
+                && polished;
             if converged {
                 if self.dynamic
                     && let Some(a) = self.adaptive.clone()
@@ -564,15 +599,35 @@ impl Integrator {
             if iter == self.newton.max_iterations {
                 break;
             }
-            if let Err(e) = self.sys.matrix.factor() {
-                self.stats.factorizations += 1;
-                let why = match crate::elements::joints::redundancy_error(&self.sys, &self.trial) {
-                    Some(r) => format!("{e}; {r}"),
-                    None => e.to_string(),
-                };
-                return Err(self.failure(h, FailureReason::Singular(why), history, fref));
+            if !tangent && (iter > 0 && rel > CONTRACTION * prev_rel || !rel.is_finite()) {
+                // The kept matrix no longer contracts well: rebuild it here.
+                tangent = true;
+                info = self.sys.assemble_with(
+                    &ctx,
+                    &self.trial,
+                    &self.trial_lambda,
+                    true,
+                    Some(&self.tmap),
+                );
             }
-            self.stats.factorizations += 1;
+            let _ = info;
+            prev_rel = rel;
+            fresh = tangent;
+            if tangent {
+                self.lu_step = f64::NAN;
+                if let Err(e) = self.sys.matrix.factor() {
+                    self.stats.factorizations += 1;
+                    let why =
+                        match crate::elements::joints::redundancy_error(&self.sys, &self.trial) {
+                            Some(r) => format!("{e}; {r}"),
+                            None => e.to_string(),
+                        };
+                    return Err(self.failure(h, FailureReason::Singular(why), history, fref));
+                }
+                self.stats.factorizations += 1;
+                self.lu_step = h;
+                tangent = false;
+            }
             self.delta.copy_from_slice(&self.sys.rhs);
             let _ = self.sys.matrix.solve(&mut self.delta);
             let (mut inc_x, mut inc_r) = (0.0f64, 0.0f64);
