@@ -36,20 +36,35 @@ pub const ENERGY_HEADER: &str = "t,kinetic,strain,gravity,total,external_work,da
 
 struct Stream {
     w: BufWriter<File>,
+    /// File name and header, for messages.
+    name: String,
+    header: String,
 }
 
 impl Stream {
     fn create(path: &Path, header: &str) -> io::Result<Self> {
         let mut w = BufWriter::new(File::create(path)?);
         writeln!(w, "{header}")?;
-        Ok(Stream { w })
+        Ok(Stream {
+            w,
+            name: path
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+            header: header.to_string(),
+        })
     }
 
     fn row(&mut self, values: &[f64]) -> io::Result<()> {
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
+            let col = self.header.split(',').nth(bad).unwrap_or("?");
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
-                format!("refusing to write a non-finite value (column {})", bad + 1),
+                format!(
+                    "refusing to write a non-finite value to {} (column {}, `{col}`, t = {})",
+                    self.name,
+                    bad + 1,
+                    values[0]
+                ),
             ));
         }
         let mut first = true;

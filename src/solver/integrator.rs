@@ -37,6 +37,16 @@ pub const CONSTRAINT_TOL: f64 = 1e-11;
 /// residual by at least 1/CONTRACTION.
 pub const CONTRACTION: f64 = 0.25;
 
+/// `max` that propagates NaN (`f64::max` drops it: a NaN residual would pass for zero).
+#[inline]
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
 /// HHT parameters derived from α.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HhtParams {
@@ -509,13 +519,13 @@ impl Integrator {
             fref = self.sys.ref_force.max(info.force_scale).max(1e-30);
             let rn = self.sys.rhs[..nn]
                 .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
+                .fold(0.0f64, |m, v| nan_max(m, v.abs()));
             // Constraint rows hold `s Φ`: a force, so they get the force tolerance too
             // (else a violation of the absolute tolerance, amplified by 1/(βh²) through the
             // inertia terms, shows up in the multipliers: Cardona & Géradin 1989).
             let cf = self.sys.rhs[nn..]
                 .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
+                .fold(0.0f64, |m, v| nan_max(m, v.abs()));
             let cn = cf / s_new;
             // Round-off of the inertia terms: positions known to ε L_ref, angles to ε rad
             // (a body spinning exactly about a principal axis has nothing else to scale by).
@@ -637,10 +647,10 @@ impl Integrator {
                         let v = -self.delta[d[c]];
                         if c < 3 {
                             self.u[i][0][c] += v;
-                            inc_x = inc_x.max(v.abs());
+                            inc_x = nan_max(inc_x, v.abs());
                         } else {
                             self.u[i][1][c - 3] += v;
-                            inc_r = inc_r.max(v.abs());
+                            inc_r = nan_max(inc_r, v.abs());
                         }
                     }
                 }
