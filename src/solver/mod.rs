@@ -168,6 +168,19 @@ pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     Ok(integ)
 }
 
+/// The adaptive step after `h` when the error estimate proposes `proposal`: the largest
+/// rung `h₀·2^(k/4)` not above the proposal; a larger step only if that is at least two
+/// rungs (×1.41) above `h`, else `h` is kept.
+pub fn ladder_step(h: f64, proposal: f64, h0: f64) -> f64 {
+    let rung = |x: f64| h0 * 2f64.powf((4.0 * (x / h0).log2() + 1e-9).floor() / 4.0);
+    let q = rung(proposal);
+    if proposal < h || q >= h * 2f64.sqrt() * (1.0 - 1e-9) {
+        q
+    } else {
+        h
+    }
+}
+
 /// Runs the model's analysis, reporting every accepted state to `obs`.
 pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<RunReport, RunError> {
     let mut integ = prepare(model)?;
@@ -273,8 +286,10 @@ pub fn run_prepared(
                 obs.progress(integ.t, end, &integ.stats);
                 good += 1;
                 if adaptive {
-                    // The local error estimate proposes the next step.
-                    h = integ.error_next.clamp(hmin, hmax);
+                    // The local error estimate proposes the next step; it is taken from
+                    // a ladder h₀·2^(k/4), and grows only by two rungs or more, so that
+                    // runs of equal steps keep the factored matrix (modified Newton).
+                    h = ladder_step(h, integ.error_next, h0).clamp(hmin, hmax);
                 } else if h < h0 && good >= 4 {
                     h = (2.0 * h).min(h0);
                     good = 0;
