@@ -430,3 +430,35 @@ fn pendulum_strikes_the_floor_within_its_energy() {
     );
     assert!(rise <= 1e-6 * rec.kin, "energy rose by {rise:e} J");
 }
+
+/// `OUTPUT … EVERY 10` with h = 1e-4 keeps the instants k·1e-3 s through the first impact,
+/// although the touch and the release add steps of their own (the steps come back to the
+/// grid): 601 rows to t = 0.6 s, none off the grid.
+#[test]
+fn histories_keep_regular_instants_through_an_impact() {
+    let mut model = load("pendulum.dat");
+    assert!(model.set_fixed_step(1e-4, 0.6, None));
+    let dir = std::env::temp_dir().join(format!("mecano_instants_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let rep = mecano::app::run_model(&model, "pendulum.dat", &dir, true).expect("run");
+    assert!(rep.failure.is_none());
+    assert!(
+        rep.stats.steps > 6000,
+        "the impact adds steps: {}",
+        rep.stats.steps
+    );
+    let text = std::fs::read_to_string(dir.join("node_23.csv")).unwrap();
+    let ts: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(ts.len(), 601);
+    for t in ts {
+        assert!(
+            (t / 1e-3 - (t / 1e-3).round()).abs() < 1e-6,
+            "t = {t} is off the grid"
+        );
+    }
+}

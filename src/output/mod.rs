@@ -82,6 +82,41 @@ impl Stream {
 /// A progress callback: time reached, end time, counters.
 pub type ProgressFn = Box<dyn FnMut(f64, f64, &Stats)>;
 
+/// Which accepted states `OUTPUT … EVERY n` writes: with fixed steps, the states at the
+/// instants `k n h` (steps land back on that grid after contact events, which add steps of
+/// their own, so a history keeps regular instants); with adaptive steps, every n-th state.
+#[derive(Debug, Clone, Copy)]
+pub struct Sampling {
+    every: u64,
+    /// `n h` for fixed steps.
+    period: Option<f64>,
+}
+
+impl Sampling {
+    /// The sampling a model asks for.
+    pub fn of(model: &crate::model::Model) -> Self {
+        let every = u64::from(model.output.every.max(1));
+        let period = match &model.analysis {
+            crate::model::Analysis::Dynamic { step, adaptive, .. } if adaptive.is_none() => {
+                Some(*step * every as f64)
+            }
+            _ => None,
+        };
+        Sampling { every, period }
+    }
+
+    /// Whether the state of a snapshot is written.
+    pub fn takes(&self, snap: &Snapshot) -> bool {
+        match self.period {
+            Some(p) => {
+                let t = snap.integ.t;
+                snap.step == 0 || (t / p - (t / p).round()).abs() <= 1e-6
+            }
+            None => snap.step.is_multiple_of(self.every),
+        }
+    }
+}
+
 /// Streams a run's histories to a directory.
 pub struct Writer {
     dir: PathBuf,
@@ -89,7 +124,7 @@ pub struct Writer {
     title: String,
     effects: Vec<&'static str>,
     end: f64,
-    every: u64,
+    sampling: Sampling,
     nodes: Vec<(usize, Stream)>,
     elements: Vec<(usize, Stream)>,
     energy: Stream,
@@ -153,7 +188,7 @@ impl Writer {
             title: model.title.clone(),
             effects: model.effects().names(),
             end,
-            every: u64::from(model.output.every.max(1)),
+            sampling: Sampling::of(model),
             nodes,
             elements,
             energy: Stream::create(&dir.join("energy.csv"), ENERGY_HEADER)?,
@@ -312,7 +347,7 @@ fn failure_json(f: &Failure) -> serde_json::Value {
 
 impl Observer for Writer {
     fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
-        if snap.step.is_multiple_of(self.every) {
+        if self.sampling.takes(snap) {
             self.write_state(snap)?;
         }
         Ok(())

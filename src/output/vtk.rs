@@ -30,7 +30,7 @@ pub const PVD_NAME: &str = "model.pvd";
 /// Streams the deformed model to a ParaView series.
 pub struct VtkWriter {
     dir: PathBuf,
-    every: u64,
+    sampling: super::Sampling,
     /// Line cells: (element number, dense node index 1, dense node index 2).
     cells: Vec<(u32, usize, usize)>,
     /// (time, file relative to the output directory) of each frame.
@@ -57,7 +57,7 @@ impl VtkWriter {
         }
         let w = VtkWriter {
             dir: dir.to_path_buf(),
-            every: u64::from(model.output.every.max(1)),
+            sampling: super::Sampling::of(model),
             cells,
             frames: Vec::new(),
             last_step: None,
@@ -188,7 +188,7 @@ impl VtkWriter {
 
 impl Observer for VtkWriter {
     fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
-        if snap.step.is_multiple_of(self.every) {
+        if self.sampling.takes(snap) {
             self.write_frame(snap)?;
         }
         Ok(())
