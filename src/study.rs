@@ -677,7 +677,7 @@ fn cpu_label(v: f64) -> String {
     let m = v / 10f64.powf(v.log10().floor());
     if ![1.0, 2.0, 5.0, 10.0]
         .iter()
-        .any(|k| (m - k).abs() < 1e-6 * k)
+        .any(|k| (m - k).abs() < 1e-3 * k)
     {
         return String::new();
     }
