@@ -453,15 +453,18 @@ impl Element for Came {
         };
         let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
         let damped = self.touching;
-        let st = self.kernel(
-            [a.x, b.x],
-            [a.r, b.r],
-            [a.v, b.v],
-            [a.w, b.w],
-            eta0,
-            false,
-            damped,
-        );
+        let kernel = |full: bool| {
+            self.kernel(
+                [a.x, b.x],
+                [a.r, b.r],
+                [a.v, b.v],
+                [a.w, b.w],
+                eta0,
+                full,
+                damped,
+            )
+        };
+        let st = kernel(false);
         let closed = st.gap < 0.0 || (self.touching && st.gap <= self.touch_tol);
         let active = self.active_flag(ctx, closed);
         let force_on = active && (!self.clip || st.force > 0.0);
@@ -469,15 +472,7 @@ impl Element for Came {
             return;
         }
         if !tangent {
-            let st = self.kernel(
-                [a.x, b.x],
-                [a.r, b.r],
-                [a.v, b.v],
-                [a.w, b.w],
-                eta0,
-                true,
-                damped,
-            );
+            let st = kernel(true);
             for (blk, v) in st.res.iter().enumerate() {
                 out.add_res(3 * blk, v);
             }
