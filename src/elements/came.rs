@@ -230,6 +230,26 @@ impl Came {
         Some(self.curve.closest_parameter(&l2))
     }
 
+    /// [`Came::kernel`] in f64 at the element's two node states.
+    fn kernel_at(
+        &self,
+        nodes: &[NodeState],
+        eta0: f64,
+        force_on: bool,
+        damped: bool,
+    ) -> ContactState<f64> {
+        let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
+        self.kernel(
+            [a.x, b.x],
+            [a.r, b.r],
+            [a.v, b.v],
+            [a.w, b.w],
+            eta0,
+            force_on,
+            damped,
+        )
+    }
+
     /// The contact kernel, generic in the scalar: gap, rate, force and nodal residual
     /// (computed as if in contact with the raw force `P`; `force_on` false gives zero
     /// forces).
@@ -310,33 +330,14 @@ impl Came {
             }
             None => return None,
         };
-        let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
-        let st = self.kernel(
-            [a.x, b.x],
-            [a.r, b.r],
-            [a.v, b.v],
-            [a.w, b.w],
-            eta0,
-            false,
-            self.touching,
-        );
-        Some(st)
+        Some(self.kernel_at(nodes, eta0, false, self.touching))
     }
 
     /// The contact state at `nodes` in f64, computed even when the bodies are apart.
     pub fn full_state(&self, nodes: &[NodeState]) -> ContactState<f64> {
         let l = self.local_point(nodes);
         let eta0 = self.curve.closest_parameter(&Vector2::new(l.x, l.y));
-        let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
-        self.kernel(
-            [a.x, b.x],
-            [a.r, b.r],
-            [a.v, b.v],
-            [a.w, b.w],
-            eta0,
-            false,
-            true,
-        )
+        self.kernel_at(nodes, eta0, false, true)
     }
 
     /// Whether the contact is closed at a state: penetrating, or within the landing
@@ -453,18 +454,7 @@ impl Element for Came {
         };
         let (a, b) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
         let damped = self.touching;
-        let kernel = |full: bool| {
-            self.kernel(
-                [a.x, b.x],
-                [a.r, b.r],
-                [a.v, b.v],
-                [a.w, b.w],
-                eta0,
-                full,
-                damped,
-            )
-        };
-        let st = kernel(false);
+        let st = self.kernel_at(nodes, eta0, false, damped);
         let closed = st.gap < 0.0 || (self.touching && st.gap <= self.touch_tol);
         let active = self.active_flag(ctx, closed);
         let force_on = active && (!self.clip || st.force > 0.0);
@@ -472,7 +462,7 @@ impl Element for Came {
             return;
         }
         if !tangent {
-            let st = kernel(true);
+            let st = self.kernel_at(nodes, eta0, true, damped);
             for (blk, v) in st.res.iter().enumerate() {
                 out.add_res(3 * blk, v);
             }
@@ -883,16 +873,7 @@ mod tests {
             let s = el.state(&st).or_else(|| {
                 let l = el.local_point(&st);
                 let eta0 = el.curve.closest_parameter(&Vector2::new(l.x, l.y));
-                let (a, b) = (&st[0], &st[1]);
-                Some(el.kernel(
-                    [a.x, b.x],
-                    [a.r, b.r],
-                    [a.v, b.v],
-                    [a.w, b.w],
-                    eta0,
-                    false,
-                    true,
-                ))
+                Some(el.kernel_at(&st, eta0, false, true))
             });
             let s = s.unwrap();
             let pi = 1 - el.s;
