@@ -323,3 +323,43 @@ pub fn run_prepared(
         failure,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::ladder_step;
+
+    /// Whether `h` is a rung `h0 2^(k/4)` (to round-off).
+    fn is_rung(h: f64, h0: f64) -> bool {
+        let k = 4.0 * (h / h0).log2();
+        (k - k.round()).abs() < 1e-6
+    }
+
+    /// The adaptive ladder: a shrinking proposal gives the largest rung not above it; a
+    /// growing one is taken (as its rung) only from two rungs (×√2) above the current step,
+    /// else the step is kept, so that runs of equal steps keep the factored matrix.
+    #[test]
+    fn ladder_steps_are_rungs_below_the_proposal_and_grow_by_two_rungs() {
+        let h0 = 1e-4;
+        let r = 2f64.powf(0.25);
+        // Shrinking: the largest rung ≤ proposal.
+        for p in [0.99e-4, 0.5e-4, 0.3e-4, 1.234e-6] {
+            let q = ladder_step(h0, p, h0);
+            assert!(
+                is_rung(q, h0) && q <= p * (1.0 + 1e-12) && q * r > p,
+                "{p:e} -> {q:e}"
+            );
+        }
+        // A rung proposal maps to itself (no round-off drift to the rung below).
+        for k in -8..=8 {
+            let rung = h0 * 2f64.powf(f64::from(k) / 4.0);
+            assert_eq!(ladder_step(rung, rung, h0), rung);
+        }
+        // Growing by less than two rungs: kept.
+        assert_eq!(ladder_step(h0, h0 * r * 1.1, h0), h0);
+        // By two rungs or more: the largest rung ≤ proposal.
+        let q = ladder_step(h0, h0 * r * r * 1.01, h0);
+        assert!(is_rung(q, h0) && (q / (h0 * r * r) - 1.0).abs() < 1e-12);
+        let q = ladder_step(h0, 10.0 * h0, h0);
+        assert!(is_rung(q, h0) && q <= 10.0 * h0 && q * r > 10.0 * h0);
+    }
+}
