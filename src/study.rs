@@ -40,8 +40,9 @@ pub struct StudyOptions {
     pub nodes: Vec<u32>,
     /// Window length, s.
     pub window: f64,
-    /// Position difference, m, below which the two finest runs count as converged whatever
-    /// their ratio to the next pair (there they differ by solver-tolerance noise).
+    /// Difference (m for positions, rad for rotations) below which the two finest runs
+    /// count as converged whatever their ratio to the next pair (there they differ by
+    /// solver-tolerance noise).
     pub floor: f64,
     /// Only study up to this time (default: the deck's end).
     pub t_max: Option<f64>,

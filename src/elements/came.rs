@@ -791,22 +791,19 @@ fn hermite_root(g0: f64, gd0: f64, g1: f64, gd1: f64, h: f64) -> Option<f64> {
 
 impl Came {
     fn row(&self, nodes: &[NodeState], st: &ContactState<f64>, p: f64, ft: f64) -> Vec<f64> {
-        let (c_pt, eta, zeta, n_c) = if self.s == 0 {
+        let (c_pt, eta, zeta) = if self.s == 0 {
             (
                 st.on_surface,
                 st.eta,
                 self.roller_coordinate(nodes, &st.normal),
-                st.normal,
             )
         } else {
             (
                 st.on_roller,
                 self.roller_coordinate(nodes, &st.normal),
                 st.eta,
-                -st.normal,
             )
         };
-        let _ = n_c;
         let active = if p != 0.0 { 1.0 } else { 0.0 };
         vec![
             active,

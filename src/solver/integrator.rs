@@ -509,7 +509,7 @@ impl Integrator {
         let mut fresh = false;
         for iter in 0..=self.newton.max_iterations {
             self.trial_from_u(h);
-            let mut info = self.sys.assemble_with(
+            let info = self.sys.assemble_with(
                 &ctx,
                 &self.trial,
                 &self.trial_lambda,
@@ -615,10 +615,11 @@ impl Integrator {
             // step converges quadratically.
             let slow = iter > 0
                 && (rel > CONTRACTION * prev_rel || 2 * iter >= self.newton.max_iterations);
-            if !tangent && (slow || !rel.is_finite()) {
-                // The kept matrix no longer contracts well: rebuild it here.
+            if !tangent && slow {
+                // The kept matrix no longer contracts well: rebuild it here (the residual
+                // is assembled again with it; `rel` above was finite, or we returned).
                 tangent = true;
-                info = self.sys.assemble_with(
+                self.sys.assemble_with(
                     &ctx,
                     &self.trial,
                     &self.trial_lambda,
@@ -626,7 +627,6 @@ impl Integrator {
                     Some(&self.tmap),
                 );
             }
-            let _ = info;
             prev_rel = rel;
             fresh = tangent;
             if tangent {
@@ -645,7 +645,9 @@ impl Integrator {
                 tangent = false;
             }
             self.delta.copy_from_slice(&self.sys.rhs);
-            let _ = self.sys.matrix.solve(&mut self.delta);
+            if let Err(e) = self.sys.matrix.solve(&mut self.delta) {
+                return Err(self.failure(h, FailureReason::Singular(e.to_string()), history, fref));
+            }
             let (mut inc_x, mut inc_r) = (0.0f64, 0.0f64);
             for (i, d) in self.sys.node_dofs.iter().enumerate() {
                 for c in 0..6 {
