@@ -88,3 +88,74 @@ fn adaptive_run_meets_its_tolerance() {
         "adaptive {n} steps vs fixed {steps_needed:.0} for the same error"
     );
 }
+
+/// Newton settings of a run: `full` = a new matrix at every iteration; `tight` = tolerances
+/// at the round-off floor (residual 1e-11 of the reference force, increment 1e-14 of the
+/// reference length) instead of the defaults (1e-8, 1e-10).
+fn run_to(name: &str, h: f64, end: f64, full: bool, tight: bool) -> (Model, History, u64) {
+    let mut m = deck(name);
+    assert!(m.set_fixed_step(h, end, None));
+    if let Analysis::Dynamic { newton, .. } = &mut m.analysis {
+        newton.modified = !full;
+        if tight {
+            newton.tol_residual = 1e-11;
+            newton.tol_increment = 1e-14;
+        }
+    }
+    let every = (1e-3 / h).round() as u64;
+    let mut r = History::new(every);
+    let report = solver::run(&m, &mut r).expect("runs");
+    assert!(report.failure.is_none(), "{name} h = {h:e} failed");
+    (m, r, report.stats.factorizations)
+}
+
+/// Largest distance of nodes 12 and 23 between two runs recorded at the same instants.
+fn max_gap(m: &Model, a: &History, b: &History) -> f64 {
+    let ids = [12, 23].map(|n| {
+        m.nodes
+            .get_index_of(&mecano::model::NodeId(n))
+            .expect("node exists")
+    });
+    assert_eq!(a.t.len(), b.t.len());
+    let mut worst: f64 = 0.0;
+    for (x, y) in a.nodes.iter().zip(&b.nodes) {
+        for &i in &ids {
+            worst = worst.max((x[i].x - y[i].x).norm());
+        }
+    }
+    worst
+}
+
+/// Modified Newton (the matrix kept while it contracts the residual, and the iterate
+/// polished until the residual stagnates) must be as accurate as full Newton at the same
+/// tolerances: what it saves is factorisations, not accuracy. Both are measured against
+/// full Newton at round-off tolerances, on each pendulum over 0.3 s at h = 1e-4 s.
+/// The stiff bars of the rigid case are where a kept-matrix iterate drifts (4.9e-5 m in
+/// 0.3 s unpolished, 5.2e-8 m polished on the residual alone, measured): residuals at the
+/// round-off floor of E = 2.1e15 bars hide errors in the mechanism's directions. Full
+/// Newton's last step converges quadratically, so it is near exact at the default
+/// tolerances; modified Newton converges linearly, and its gap must stay below a tenth of
+/// the time discretisation error that both runs carry (estimated by the run at h/2:
+/// `|x_h − x_{h/2}| ≈ ¾ |x_h − x|` at order 2), while it factors less.
+#[test]
+fn modified_newton_is_as_accurate_as_full_newton() {
+    for (name, end) in [("pendulum_rigid.dat", 0.3), ("pendulum.dat", 0.3)] {
+        let h = 1e-4;
+        let (m, exact, _) = run_to(name, h, end, true, true);
+        let (_, modified, f_mod) = run_to(name, h, end, false, false);
+        let (_, full, f_full) = run_to(name, h, end, true, false);
+        let (_, half, _) = run_to(name, h / 2.0, end, false, false);
+        let gap_mod = max_gap(&m, &modified, &exact);
+        let gap_full = max_gap(&m, &full, &exact);
+        let discretisation = max_gap(&m, &modified, &half);
+        eprintln!(
+            "{name}: from Newton at round-off tolerances: modified {gap_mod:.2e} m, full \
+             {gap_full:.2e} m; h vs h/2 {discretisation:.2e} m; factorisations {f_mod} vs {f_full}"
+        );
+        assert!(
+            gap_mod <= 0.1 * discretisation,
+            "{name}: modified Newton off by {gap_mod:e} m (discretisation {discretisation:e} m)"
+        );
+        assert!(f_mod < f_full);
+    }
+}

@@ -98,6 +98,12 @@ fn malformed_decks_table() {
         ),
         ("ANALYSIS STATIC MAXIT 1.5\n".into(), 1, 23, "whole number"),
         (
+            "ANALYSIS STATIC NEWTON FAST\n".into(),
+            1,
+            24,
+            "FULL or MODIFIED",
+        ),
+        (
             format!("FUNCTIONS\n 1 TABLE 0 0 1\n{A}"),
             2,
             2,

@@ -1199,10 +1199,10 @@ impl<'s> Builder<'s> {
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
                 "ALPHA", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT",
-                "GROWTH", "TOL", "TOLINC", "MAXIT",
+                "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
             ]
         } else {
-            &["STEPS", "TOL", "TOLINC", "MAXIT"]
+            &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
         };
         let mut seen = Seen::default();
         let mut newton = NewtonSettings::default();
@@ -1238,6 +1238,10 @@ impl<'s> Builder<'s> {
                         return Err(out_of_range("MAXIT", "0", ">= 1", s));
                     }
                     newton.max_iterations = n;
+                }
+                "NEWTON" => {
+                    let (v, _) = c.expect_keyword(&["FULL", "MODIFIED"], "FULL or MODIFIED")?;
+                    newton.modified = v == "MODIFIED";
                 }
                 _ => {
                     let (n, s) = c.uint("STEPS")?;

@@ -300,6 +300,17 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "Newton iteration limit (>= 1, default 20)",
     ),
     kw(
+        "NEWTON",
+        "ANALYSIS",
+        "FULL (new matrix every iteration) or MODIFIED (default: kept while it contracts)",
+    ),
+    kw("FULL", "ANALYSIS", "NEWTON FULL: full Newton-Raphson"),
+    kw(
+        "MODIFIED",
+        "ANALYSIS",
+        "NEWTON MODIFIED: modified Newton (default)",
+    ),
+    kw(
         "STEPS",
         "ANALYSIS",
         "number of static load steps (>= 1, default 1)",

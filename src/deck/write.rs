@@ -235,15 +235,21 @@ pub fn write_deck(model: &Model) -> String {
             }
             let _ = writeln!(
                 s,
-                " &\n  TOL {:?} TOLINC {:?} MAXIT {}",
-                newton.tol_residual, newton.tol_increment, newton.max_iterations
+                " &\n  TOL {:?} TOLINC {:?} MAXIT {} NEWTON {}",
+                newton.tol_residual,
+                newton.tol_increment,
+                newton.max_iterations,
+                newton_kind(newton)
             );
         }
         Analysis::Static { steps, newton } => {
             let _ = writeln!(
                 s,
-                "ANALYSIS STATIC STEPS {steps} TOL {:?} TOLINC {:?} MAXIT {}",
-                newton.tol_residual, newton.tol_increment, newton.max_iterations
+                "ANALYSIS STATIC STEPS {steps} TOL {:?} TOLINC {:?} MAXIT {} NEWTON {}",
+                newton.tol_residual,
+                newton.tol_increment,
+                newton.max_iterations,
+                newton_kind(newton)
             );
         }
     }
@@ -263,4 +269,8 @@ pub fn write_deck(model: &Model) -> String {
     }
     s.push_str("\nEND\n");
     s
+}
+
+fn newton_kind(n: &crate::model::NewtonSettings) -> &'static str {
+    if n.modified { "MODIFIED" } else { "FULL" }
 }

@@ -255,16 +255,17 @@ impl Element for Beam {
     }
 
     fn force_scale(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> f64 {
+        // Squared norms, one square root.
         let m = 0.5 * self.translational_mass();
-        let mut f = m * gravity.norm();
+        let mut f2 = m * m * gravity.norm_squared();
         for &i in &self.nodes {
             let s = &nodes[i];
-            f = f
-                .max(m * s.a.norm())
-                .max((self.j_node * s.wd).norm())
-                .max(s.w.cross(&(self.j_node * s.w)).norm());
+            f2 = f2
+                .max(m * m * s.a.norm_squared())
+                .max((self.j_node * s.wd).norm_squared())
+                .max(s.w.cross(&(self.j_node * s.w)).norm_squared());
         }
-        f
+        f2.sqrt()
     }
 
     fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {

@@ -325,6 +325,10 @@ pub struct NewtonSettings {
     pub tol_increment: f64,
     /// Iteration limit per step (default 20).
     pub max_iterations: u32,
+    /// Modified Newton (default): the factored iteration matrix is kept, across iterations
+    /// and steps of the same size, while it contracts the residual; `false` = full Newton,
+    /// a new matrix at every iteration (deck: `NEWTON FULL`).
+    pub modified: bool,
 }
 
 impl Default for NewtonSettings {
@@ -333,6 +337,7 @@ impl Default for NewtonSettings {
             tol_residual: 1e-8,
             tol_increment: 1e-10,
             max_iterations: 20,
+            modified: true,
         }
     }
 }

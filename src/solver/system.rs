@@ -307,7 +307,13 @@ impl System {
         let mut info = AssemblyInfo::default();
         for (e, el) in self.elements.iter().enumerate() {
             let local = &mut self.locals[e];
-            local.clear();
+            // Residual-only assemblies leave `tan` as it was: it is read only after a
+            // tangent assembly, which clears it.
+            if tangent {
+                local.clear();
+            } else {
+                local.res.iter_mut().for_each(|v| *v = 0.0);
+            }
             let k = el.multipliers();
             let o = self.mult_offset[e];
             el.evaluate(ctx, nodes, &lambda[o..o + k], tangent, local);
