@@ -500,11 +500,19 @@ impl<'s> Builder<'s> {
         let mut c = Cursor::new(card, "FUNCTIONS card");
         let (id, id_span) = c.uint("function number")?;
         c.ctx = format!("function {id}");
-        let (kw, _) = c.expect_keyword(&["TABLE", "CONSTANT"], "TABLE or CONSTANT")?;
+        let (kw, _) = c.expect_keyword(
+            &["TABLE", "CONSTANT", "HAVERSINE"],
+            "TABLE, CONSTANT or HAVERSINE",
+        )?;
         let function = if kw == "CONSTANT" {
             let (v, _, _) = c.number("the constant value")?;
             c.finish()?;
             Function::Constant(v)
+        } else if kw == "HAVERSINE" {
+            let (start, _, _) = c.number("the pulse's start time")?;
+            let duration = c.number_in("the pulse's duration", "> 0 s", |v| v > 0.0)?;
+            c.finish()?;
+            Function::Haversine { start, duration }
         } else {
             let mut vals = Vec::new();
             while c.peek().is_some() {

@@ -244,6 +244,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "piecewise-linear table of (t, f) pairs",
     ),
     kw("CONSTANT", "FUNCTIONS", "a constant function"),
+    kw(
+        "HAVERSINE",
+        "FUNCTIONS",
+        "a smooth pulse sin²(π(t−t0)/T) on [t0, t0+T]",
+    ),
     // loads
     kw("GRAVITY", "LOADS", "gravity acceleration vector, m/s²"),
     kw("FORCE", "LOADS", "nodal force, N, global frame"),

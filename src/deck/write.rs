@@ -119,6 +119,9 @@ pub fn write_deck(model: &Model) -> String {
                 Function::Constant(v) => {
                     let _ = writeln!(s, "  {} CONSTANT {v:?}", f.id.0);
                 }
+                Function::Haversine { start, duration } => {
+                    let _ = writeln!(s, "  {} HAVERSINE {start:?} {duration:?}", f.id.0);
+                }
                 Function::Table(pts) => {
                     let _ = write!(s, "  {} TABLE", f.id.0);
                     for (t, v) in pts {

@@ -92,6 +92,16 @@ pub enum Function {
     Table(Vec<(f64, f64)>),
     /// A constant value.
     Constant(f64),
+    /// The haversine pulse `f(t) = sin²(π (t − t₀)/T)` for `t₀ ≤ t ≤ t₀ + T`, 0 elsewhere:
+    /// peak 1 at the middle, impulse `T/2` (the triangle 0 → 1 → 0 over `T` has the same),
+    /// continuous with its first derivative (a jump of `2π²/T²` in `f''` at both ends),
+    /// where a triangle has jumps in `f'`.
+    Haversine {
+        /// Start time t₀, s.
+        start: f64,
+        /// Duration T, s (> 0).
+        duration: f64,
+    },
 }
 
 impl Function {
@@ -99,6 +109,14 @@ impl Function {
     pub fn eval(&self, t: f64) -> f64 {
         match self {
             Function::Constant(c) => *c,
+            Function::Haversine { start, duration } => {
+                let s = (t - start) / duration;
+                if (0.0..=1.0).contains(&s) {
+                    (std::f64::consts::PI * s).sin().powi(2)
+                } else {
+                    0.0
+                }
+            }
             Function::Table(pts) => {
                 let Some(first) = pts.first() else { return 0.0 };
                 if t <= first.0 {
@@ -124,6 +142,7 @@ impl Function {
     pub fn breakpoints(&self) -> Vec<f64> {
         match self {
             Function::Constant(_) => Vec::new(),
+            Function::Haversine { start, duration } => vec![*start, start + duration],
             Function::Table(p) => p.iter().map(|x| x.0).collect(),
         }
     }
@@ -475,4 +494,56 @@ pub struct Model {
     pub analysis: Analysis,
     /// Output requests.
     pub output: OutputRequest,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Function;
+
+    /// The haversine pulse: values at the quarter points, zero outside, impulse T/2
+    /// (Simpson's rule on 2000 intervals: exact to ~1e-13 for this smooth integrand), and
+    /// a slope that vanishes at both ends (continuous with the zero outside).
+    #[test]
+    fn haversine_pulse_values_impulse_and_slope() {
+        let f = Function::Haversine {
+            start: 0.1,
+            duration: 0.02,
+        };
+        for (t, v) in [
+            (0.1, 0.0),
+            (0.105, 0.5),
+            (0.11, 1.0),
+            (0.115, 0.5),
+            (0.12, 0.0),
+        ] {
+            assert!((f.eval(t) - v).abs() < 1e-12, "f({t}) = {}", f.eval(t));
+        }
+        assert_eq!(f.eval(0.0999), 0.0);
+        assert_eq!(f.eval(0.1201), 0.0);
+        let n = 2000;
+        let dt = 0.02 / n as f64;
+        let simpson: f64 = (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f.eval(0.1 + i as f64 * dt)
+            })
+            .sum::<f64>()
+            * dt
+            / 3.0;
+        assert!((simpson - 0.01).abs() < 1e-12, "impulse {simpson}");
+        let d = 1e-7;
+        for t in [0.1, 0.12] {
+            let slope = (f.eval(t + d) - f.eval(t - d)) / (2.0 * d);
+            // f ≈ (π s)² near the ends: slope over ±d at most π² d / T² ≈ 2.5e-3.
+            assert!(slope.abs() < 3e-3, "slope {slope} at {t}");
+        }
+        let b = f.breakpoints();
+        assert!(b.len() == 2 && b[0] == 0.1 && (b[1] - 0.12).abs() < 1e-15);
+    }
 }

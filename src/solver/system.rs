@@ -237,6 +237,7 @@ impl System {
         for l in &loads {
             let fmax = l.function.as_ref().map_or(1.0, |f| match f {
                 Function::Constant(c) => c.abs(),
+                Function::Haversine { .. } => 1.0,
                 Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
             });
             let scale = if l.moment { 1.0 / ref_length } else { 1.0 };
