@@ -228,11 +228,6 @@ impl Local {
     /// Sets everything to zero.
     pub fn clear(&mut self) {
         self.res.iter_mut().for_each(|v| *v = 0.0);
-        self.clear_tangent();
-    }
-
-    /// Sets the tangent (and rate) blocks to zero, leaving the residual.
-    pub fn clear_tangent(&mut self) {
         self.tan.iter_mut().for_each(|v| *v = 0.0);
         if self.has_rate {
             self.rate.iter_mut().for_each(|v| *v = 0.0);

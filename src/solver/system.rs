@@ -313,7 +313,7 @@ impl System {
             if tangent {
                 local.clear();
             } else {
-                local.res.iter_mut().for_each(|v| *v = 0.0);
+                local.res.fill(0.0);
             }
             let k = el.multipliers();
             let o = self.mult_offset[e];
