@@ -69,9 +69,8 @@ struct Factors {
     u_row: Vec<usize>,
     u_val: Vec<f64>,
     u_diag: Vec<f64>,
-    /// Row perm: `row_fwd[k]` = row of `A` pivoted at step k; `row_inv` its inverse.
+    /// Row perm: `row_fwd[k]` = row of `A` pivoted at step k.
     row_fwd: Vec<usize>,
-    row_inv: Vec<usize>,
     /// Column order `Q`: `col_fwd[j]` = column of `A` eliminated at step j.
     col_fwd: Vec<usize>,
     /// Pivot-order row of each stored entry of `A`.
@@ -133,8 +132,6 @@ impl Factors {
         }
         self.row_fwd.clear();
         self.row_fwd.extend_from_slice(row_fwd);
-        self.row_inv.clear();
-        self.row_inv.extend_from_slice(row_inv);
         self.col_fwd.clear();
         self.col_fwd.extend_from_slice(col_fwd);
         self.a_row.clear();
