@@ -166,28 +166,32 @@ impl Beam {
     }
 
     /// Internal forces and their exact derivative with respect to `[δx₁, δΘ₁, δx₂, δΘ₂]`,
-    /// by forward-mode AD with 12 dual directions.
+    /// by forward-mode AD with 9 dual directions: the kernel sees the positions only
+    /// through `x₂ − x₁`, so `∂f/∂x₁ = −∂f/∂x₂` and x₁ needs no directions of its own.
     fn internal_with_tangent(&self, s1: &NodeState, s2: &NodeState, out: &mut Local) {
-        type D = Dual<12>;
+        type D = Dual<9>;
         let seed = |v: f64, k: usize| D::var(v, k);
         let lift = D::constant;
-        let xs = |x: &Vector3<f64>, base: usize| {
-            Vector3::new(seed(x.x, base), seed(x.y, base + 1), seed(x.z, base + 2))
-        };
         let rs = |r: &Matrix3<f64>, base: usize| {
             // R (I + δΘ̃): exact to first order, which is all a dual number carries.
             let dth = Vector3::new(seed(0.0, base), seed(0.0, base + 1), seed(0.0, base + 2));
             let rr: Matrix3<D> = r.map(lift);
             rr + rotation::mm(&rr, &skew(&dth))
         };
-        let k = self.kernel(xs(&s1.x, 0), xs(&s2.x, 6), rs(&s1.r, 3), rs(&s2.r, 9));
+        let x1 = s1.x.map(lift);
+        let x2 = Vector3::new(seed(s2.x.x, 0), seed(s2.x.y, 1), seed(s2.x.z, 2));
+        let k = self.kernel(x1, x2, rs(&s1.r, 3), rs(&s2.r, 6));
         let n = out.n;
         for (blk, v) in k.f.iter().enumerate() {
             for comp in 0..3 {
                 let row = 3 * blk + comp;
                 out.res[row] += v[comp].re;
-                for (col, e) in v[comp].eps.iter().enumerate() {
-                    out.tan[col * n + row] += e;
+                let e = &v[comp].eps;
+                for c in 0..3 {
+                    out.tan[c * n + row] -= e[c]; // x₁
+                    out.tan[(c + 6) * n + row] += e[c]; // x₂
+                    out.tan[(c + 3) * n + row] += e[c + 3]; // Θ₁
+                    out.tan[(c + 9) * n + row] += e[c + 6]; // Θ₂
                 }
             }
         }
