@@ -23,6 +23,9 @@ pub struct Stats {
     pub newton_iterations: u64,
     /// Numeric LU factorisations (accepted and rejected attempts).
     pub factorizations: u64,
+    /// Of those, the ones that searched for pivots; the others were refactorisations on
+    /// the pivots of an earlier one ([`linear`]).
+    pub pivot_searches: u64,
     /// Rejected (cut) step attempts.
     pub rejected_steps: u64,
     /// Restarts of the accelerations at events (e.g. contact touches).
@@ -278,6 +281,7 @@ pub fn run_prepared(
                 let v = integ.constraint_violation();
                 integ.stats.max_constraint_violation = integ.stats.max_constraint_violation.max(v);
                 integ.stats.cpu_seconds = start.elapsed().as_secs_f64();
+                integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
                 obs.state(&Snapshot {
                     integ,
                     step: integ.stats.steps,
@@ -317,6 +321,7 @@ pub fn run_prepared(
         integ.stats.min_step = 0.0;
     }
     integ.stats.cpu_seconds = start.elapsed().as_secs_f64();
+    integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
     Ok(RunReport {
         stats: integ.stats,
         time: integ.t,
