@@ -166,32 +166,48 @@ impl Beam {
     }
 
     /// Internal forces and their exact derivative with respect to `[δx₁, δΘ₁, δx₂, δΘ₂]`,
-    /// by forward-mode AD with 9 dual directions: the kernel sees the positions only
-    /// through `x₂ − x₁`, so `∂f/∂x₁ = −∂f/∂x₂` and x₁ needs no directions of its own.
+    /// by forward-mode AD with 6 dual directions (`δx₂`, `δΘ₁`) and the element's two
+    /// invariances for the other six columns:
+    /// - translation: the kernel sees the positions only through `x₂ − x₁`, so
+    ///   `∂f/∂x₁ = −∂f/∂x₂`;
+    /// - rotation (objectivity): a superposed rotation `δφ` moves `δx_i = δφ × x_i`,
+    ///   `δΘ_i = R_iᵀ δφ` and changes `f` by `G δφ` (the global forces `∓F` turn,
+    ///   `G = [F̃; 0; −F̃; 0]`, the material moments do not), so
+    ///   `A₂ (x̃₁ − x̃₂) + B₁ R₁ᵀ + B₂ R₂ᵀ = G` with `A_i = ∂f/∂x_i`, `B_i = ∂f/∂Θ_i`,
+    ///   which gives `B₂ = (G − A₂ (x̃₁ − x̃₂) − B₁ R₁ᵀ) R₂`.
     fn internal_with_tangent(&self, s1: &NodeState, s2: &NodeState, out: &mut Local) {
-        type D = Dual<9>;
+        type D = Dual<6>;
         let seed = |v: f64, k: usize| D::var(v, k);
         let lift = D::constant;
-        let rs = |r: &Matrix3<f64>, base: usize| {
-            // R (I + δΘ̃): exact to first order, which is all a dual number carries.
-            let dth = Vector3::new(seed(0.0, base), seed(0.0, base + 1), seed(0.0, base + 2));
-            let rr: Matrix3<D> = r.map(lift);
-            rr + rotation::mm(&rr, &skew(&dth))
-        };
+        // R₁ (I + δΘ̃₁): exact to first order, which is all a dual number carries.
+        let dth = Vector3::new(seed(0.0, 3), seed(0.0, 4), seed(0.0, 5));
+        let r1: Matrix3<D> = s1.r.map(lift);
+        let r1 = r1 + rotation::mm(&r1, &skew(&dth));
         let x1 = s1.x.map(lift);
         let x2 = Vector3::new(seed(s2.x.x, 0), seed(s2.x.y, 1), seed(s2.x.z, 2));
-        let k = self.kernel(x1, x2, rs(&s1.r, 3), rs(&s2.r, 6));
+        let k = self.kernel(x1, x2, r1, s2.r.map(lift));
+        let force = Vector3::new(k.f[2].x.re, k.f[2].y.re, k.f[2].z.re);
+        let g = skew(&force);
+        let dx = skew(&(s1.x - s2.x));
         let n = out.n;
         for (blk, v) in k.f.iter().enumerate() {
-            for comp in 0..3 {
-                let row = 3 * blk + comp;
-                out.res[row] += v[comp].re;
-                let e = &v[comp].eps;
+            // Rows 3·blk.. of A₂ and B₁, as 3×3 blocks.
+            let a2 = Matrix3::from_fn(|r, c| v[r].eps[c]);
+            let b1 = Matrix3::from_fn(|r, c| v[r].eps[c + 3]);
+            let gb = match blk {
+                0 => g,
+                2 => -g,
+                _ => Matrix3::zeros(),
+            };
+            let b2 = (gb - a2 * dx - b1 * s1.r.transpose()) * s2.r;
+            for r in 0..3 {
+                let row = 3 * blk + r;
+                out.res[row] += v[r].re;
                 for c in 0..3 {
-                    out.tan[c * n + row] -= e[c]; // x₁
-                    out.tan[(c + 6) * n + row] += e[c]; // x₂
-                    out.tan[(c + 3) * n + row] += e[c + 3]; // Θ₁
-                    out.tan[(c + 9) * n + row] += e[c + 6]; // Θ₂
+                    out.tan[c * n + row] -= a2[(r, c)]; // x₁
+                    out.tan[(c + 3) * n + row] += b1[(r, c)]; // Θ₁
+                    out.tan[(c + 6) * n + row] += a2[(r, c)]; // x₂
+                    out.tan[(c + 9) * n + row] += b2[(r, c)]; // Θ₂
                 }
             }
         }
