@@ -189,6 +189,7 @@ impl Beam {
         let force = Vector3::new(k.f[2].x.re, k.f[2].y.re, k.f[2].z.re);
         let g = skew(&force);
         let dx = skew(&(s1.x - s2.x));
+        let r1t = s1.r.transpose();
         let n = out.n;
         for (blk, v) in k.f.iter().enumerate() {
             // Rows 3·blk.. of A₂ and B₁, as 3×3 blocks.
@@ -199,7 +200,7 @@ impl Beam {
                 2 => -g,
                 _ => Matrix3::zeros(),
             };
-            let b2 = (gb - a2 * dx - b1 * s1.r.transpose()) * s2.r;
+            let b2 = (gb - a2 * dx - b1 * r1t) * s2.r;
             for r in 0..3 {
                 let row = 3 * blk + r;
                 out.res[row] += v[r].re;
