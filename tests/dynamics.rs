@@ -4,7 +4,7 @@
 
 use mecano::deck::load_deck;
 use mecano::elements::NodeState;
-use mecano::model::{Model, NodeId};
+use mecano::model::{Function, Model, NodeId};
 use mecano::output::History;
 use mecano::rotation;
 use mecano::solver;
@@ -375,4 +375,27 @@ fn fixed_steps_land_on_load_kinks_without_slivers() {
     for w in hist.t.windows(2) {
         assert!((w[1] - w[0] - h0).abs() < 1e-6 * h0, "{} -> {}", w[0], w[1]);
     }
+    // A kink just off the grid (1e-5 h after 0.01 s, at h = 1e-4 s) is not a step of
+    // its own either (it is taken as reached); the shortest step is the one that lands
+    // on the other kink, 1e-5 h before 0.02 s, and the next one comes back to the grid.
+    let mut model = deck("pendulum.dat");
+    let h0 = 1e-4;
+    set_dynamic(&mut model, h0, 0.03, None);
+    let f = model
+        .functions
+        .values_mut()
+        .next()
+        .expect("the torque's table");
+    f.function = Function::Table(vec![
+        (0.0, 0.0),
+        (0.01 + 1e-5 * h0, 1.0),
+        (0.02 - 1e-5 * h0, 0.0),
+    ]);
+    let report = solver::run(&model, &mut History::new(1)).expect("run starts");
+    assert!(report.failure.is_none());
+    assert!(
+        report.stats.min_step > 0.99 * h0,
+        "shortest step {:e} of h = {h0:e}",
+        report.stats.min_step
+    );
 }
