@@ -286,7 +286,11 @@ pub fn run_study(
     let d12 = errors_between(ref_i - 1, ref_i - 2);
     let reference_uncertainty = d01.clone();
     let converged: Vec<[bool; 3]> = (0..nwin)
-        .map(|w| std::array::from_fn(|c| d01[w][c] <= 0.5 * d12[w][c] || d01[w][c] <= opts.floor))
+        .map(|w| {
+            std::array::from_fn(|c| {
+                d01[w][c].is_finite() && (d01[w][c] <= 0.5 * d12[w][c] || d01[w][c] <= opts.floor)
+            })
+        })
         .collect();
     for (i, run) in runs.iter_mut().enumerate() {
         run.window_errors = if i == ref_i {
@@ -294,11 +298,13 @@ pub fn run_study(
         } else {
             errors_between(i, ref_i)
         };
-        let mut e = [0.0f64; 3];
+        // NaN (reported as "-", never written as a number) where no window of the
+        // quantity is converged.
+        let mut e = [f64::NAN; 3];
         for w in 0..nwin {
             for c in 0..3 {
                 if converged[w][c] {
-                    e[c] = e[c].max(run.window_errors[w][c]);
+                    e[c] = run.window_errors[w][c].max(if e[c].is_nan() { 0.0 } else { e[c] });
                 }
             }
         }
@@ -334,6 +340,28 @@ pub fn run_study(
     Ok(report)
 }
 
+/// An error for the CSV files: empty where it is not a number (no converged window, or a
+/// run that stopped early), so that no NaN or infinity is written.
+fn csv_number(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:e}")
+    } else {
+        String::new()
+    }
+}
+
+/// An error for the printed table: `-` where no window is converged, `stopped` where the
+/// run stopped before the window's end.
+fn table_number(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.2e}")
+    } else if x.is_nan() {
+        "-".into()
+    } else {
+        "stopped".into()
+    }
+}
+
 /// Writes `study.csv` (one row per run) and `study_windows.csv` (one row per run and window).
 pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
     std::fs::create_dir_all(dir)?;
@@ -366,9 +394,9 @@ pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
             run.stats.factorizations.to_string(),
             run.stats.rejected_steps.to_string(),
             run.complete.to_string(),
-            format!("{:e}", run.error[0]),
-            format!("{:e}", run.error[1]),
-            format!("{:e}", run.error[2]),
+            csv_number(run.error[0]),
+            csv_number(run.error[1]),
+            csv_number(run.error[2]),
             run.order.map_or(String::new(), |o| format!("{o:.3}")),
         ])?;
     }
@@ -396,12 +424,12 @@ pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
                 r.converged[k][0].to_string(),
                 r.converged[k][1].to_string(),
                 r.converged[k][2].to_string(),
-                format!("{:e}", r.reference_uncertainty[k][0]),
-                format!("{:e}", r.reference_uncertainty[k][1]),
-                format!("{:e}", r.reference_uncertainty[k][2]),
-                format!("{:e}", e[0]),
-                format!("{:e}", e[1]),
-                format!("{:e}", e[2]),
+                csv_number(r.reference_uncertainty[k][0]),
+                csv_number(r.reference_uncertainty[k][1]),
+                csv_number(r.reference_uncertainty[k][2]),
+                csv_number(e[0]),
+                csv_number(e[1]),
+                csv_number(e[2]),
             ])?;
         }
     }
@@ -419,13 +447,13 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
         let (c, d) = (r.converged[k], r.reference_uncertainty[k]);
         writeln!(
             out,
-            "  [{t:6.3}, …)  x {} ({:.2e} m)  R {} ({:.2e} rad)  v {} ({:.2e} m/s)",
+            "  [{t:6.3}, …)  x {} ({} m)  R {} ({} rad)  v {} ({} m/s)",
             flag(c[0]),
-            d[0],
+            table_number(d[0]),
             flag(c[1]),
-            d[1],
+            table_number(d[1]),
             flag(c[2]),
-            d[2]
+            table_number(d[2])
         )?;
     }
     writeln!(
@@ -436,15 +464,15 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
     for run in &r.runs {
         writeln!(
             out,
-            "{:<32} {:>9.3} {:>8} {:>8} {:>8} {:>10.2e} {:>10.2e} {:>10.2e} {:>6}",
+            "{:<32} {:>9.3} {:>8} {:>8} {:>8} {:>10} {:>10} {:>10} {:>6}",
             run.label,
             run.stats.cpu_seconds,
             run.stats.steps,
             run.stats.newton_iterations,
             run.stats.factorizations,
-            run.error[0],
-            run.error[1],
-            run.error[2],
+            table_number(run.error[0]),
+            table_number(run.error[1]),
+            table_number(run.error[2]),
             run.order.map_or("-".into(), |o| format!("{o:.2}")),
         )?;
     }
@@ -702,4 +730,21 @@ fn cpu_label(v: f64) -> String {
     }
     let s = format!("{v:.4}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{csv_number, table_number};
+
+    /// A quantity without a converged window (NaN) or a run that stopped (infinite error)
+    /// is an empty CSV field and a word in the table, never a NaN or `inf` in a file.
+    #[test]
+    fn errors_that_are_not_numbers_are_not_written_as_numbers() {
+        assert_eq!(csv_number(f64::NAN), "");
+        assert_eq!(csv_number(f64::INFINITY), "");
+        assert_eq!(csv_number(2.5e-4), "2.5e-4");
+        assert_eq!(table_number(f64::NAN), "-");
+        assert_eq!(table_number(f64::INFINITY), "stopped");
+        assert_eq!(table_number(2.5e-4), "2.50e-4");
+    }
 }

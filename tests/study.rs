@@ -72,5 +72,9 @@ fn study_reports_order_two_on_the_free_body() {
             assert_eq!(&r[c], "true");
         }
     }
+    for f in ["study.csv", "study_windows.csv"] {
+        let text = std::fs::read_to_string(dir.join(f)).unwrap().to_lowercase();
+        assert!(!text.contains("nan") && !text.contains("inf"), "{f}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
