@@ -25,7 +25,7 @@ use crate::model::{Model, Selection};
 use crate::rotation;
 use crate::solver::{Failure, Observer, RunReport, Snapshot, Stats, System};
 use std::fs::{self, File};
-use std::io::{self, BufWriter, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 
 /// Header of every node history file.
@@ -35,22 +35,31 @@ pub const NODE_HEADER: &str = "t,x,y,z,ux,uy,uz,rx,ry,rz,vx,vy,vz,wx,wy,wz,ax,ay
 pub const ENERGY_HEADER: &str = "t,kinetic,strain,gravity,total,external_work,damping_dissipation,numerical_dissipation,balance_residual";
 
 struct Stream {
-    w: BufWriter<File>,
+    w: csv::Writer<File>,
     /// File name and header, for messages.
     name: String,
     header: String,
+    /// Shortest round-trip formatting of a number (Ryū: Adams, PLDI 2018), several
+    /// times faster than `{:e}` (Grisu with a Dragon4 fallback), which took 30 % of a
+    /// run that wrote every node and element at every step (`OUTPUT`'s default).
+    num: ryu::Buffer,
 }
 
 impl Stream {
     fn create(path: &Path, header: &str) -> io::Result<Self> {
-        let mut w = BufWriter::new(File::create(path)?);
-        writeln!(w, "{header}")?;
+        // Numbers and column names never need quotes: the writer need not scan for them.
+        let mut w = csv::WriterBuilder::new()
+            .has_headers(false)
+            .quote_style(csv::QuoteStyle::Never)
+            .from_path(path)?;
+        w.write_record(header.split(','))?;
         Ok(Stream {
             w,
             name: path
                 .file_name()
                 .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
             header: header.to_string(),
+            num: ryu::Buffer::new(),
         })
     }
 
@@ -67,15 +76,11 @@ impl Stream {
                 ),
             ));
         }
-        let mut first = true;
         for v in values {
-            if !first {
-                self.w.write_all(b",")?;
-            }
-            first = false;
-            write!(self.w, "{v:e}")?;
+            self.w.write_field(self.num.format_finite(*v))?;
         }
-        self.w.write_all(b"\n")
+        self.w.write_record(std::iter::empty::<&[u8]>())?;
+        Ok(())
     }
 }
 
