@@ -322,10 +322,11 @@ impl Element for Beam {
         let (g, k) = self.strains(&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
         let n = g.component_mul(&self.props.cn);
         let m = k.component_mul(&self.props.cm);
-        [n, m, g, k]
-            .iter()
-            .flat_map(|v| v.iter().copied())
-            .collect()
+        let mut row = Vec::with_capacity(12);
+        for v in [n, m, g, k] {
+            row.extend_from_slice(v.as_slice());
+        }
+        row
     }
 }
 

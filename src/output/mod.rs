@@ -137,6 +137,8 @@ pub struct Writer {
     energy_scale: f64,
     max_balance: f64,
     last_row: Option<u64>,
+    /// An element's row, reused (no allocation per row).
+    row: Vec<f64>,
     /// Optional progress callback (e.g. a progress bar): time, end time, counters.
     pub progress: Option<ProgressFn>,
 }
@@ -201,6 +203,7 @@ impl Writer {
             energy_scale: 0.0,
             max_balance: 0.0,
             last_row: None,
+            row: Vec::new(),
             progress: None,
         };
         w.write_summary(None, None)?;
@@ -231,9 +234,11 @@ impl Writer {
         for (e, st) in &mut self.elements {
             let el = &integ.sys.elements[*e];
             let lam = integ.sys.element_lambda(*e, &integ.lambda);
-            let mut row = vec![t];
+            let row = &mut self.row;
+            row.clear();
+            row.push(t);
             row.extend(el.output_row(&ctx, &integ.nodes, lam));
-            st.row(&row)?;
+            st.row(row)?;
         }
         let e = integ.energies();
         let total = e.kinetic + e.strain + e.gravity;
