@@ -12,12 +12,12 @@
 //! noise of the Newton tolerance, and its ratio to the next pair says nothing). This is
 //! judged for each quantity on its own — positions, rotations (the same floor in rad),
 //! velocities (in m/s) — because they converge differently: on the pendulum the tip
-//! rotations, driven by the bars' torsion, converge at order ~1 before the impact where
-//! the positions converge at ~1.5. Each quantity's error is the largest over the windows
-//! where its reference is converged. The observed order is measured on positions (on
-//! rotations if the chosen nodes do not move). The work–precision figure (position error
-//! against CPU time) uses the position-converged windows only, as the IFToMM benchmark
-//! protocol compares codes at given precision bands.
+//! rotations, driven by the bars' torsion, converge at order 1.1–1.5 before the impact
+//! where the positions converge at 1.5–1.9 (`docs/accuracy.md`). Each quantity's error is
+//! the largest over the windows where its reference is converged. The observed order is
+//! measured on positions (on rotations if the chosen nodes do not move). The
+//! work–precision figure (position error against CPU time) uses the position-converged
+//! windows only, as the IFToMM benchmark protocol compares codes at given precision bands.
 //!
 //! Samples are taken on the grid of the coarsest fixed step (which every fixed run hits);
 //! adaptive runs are interpolated there with cubic Hermite polynomials in position and
