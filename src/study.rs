@@ -299,12 +299,12 @@ pub fn run_study(
             errors_between(i, ref_i)
         };
         // NaN (reported as "-", never written as a number) where no window of the
-        // quantity is converged.
+        // quantity is converged; `NaN.max(x)` is x.
         let mut e = [f64::NAN; 3];
         for w in 0..nwin {
             for c in 0..3 {
                 if converged[w][c] {
-                    e[c] = run.window_errors[w][c].max(if e[c].is_nan() { 0.0 } else { e[c] });
+                    e[c] = e[c].max(run.window_errors[w][c]);
                 }
             }
         }
