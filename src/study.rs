@@ -69,6 +69,8 @@ pub struct StudyRun {
     pub stats: solver::Stats,
     /// The run reached its end.
     pub complete: bool,
+    /// Where and why the run stopped, if it did not reach its end.
+    pub stopped: Option<String>,
     /// Errors per window: (position, rotation, velocity).
     pub window_errors: Vec<[f64; 3]>,
     /// Errors over the converged windows of each quantity: (position, rotation, velocity).
@@ -249,6 +251,11 @@ pub fn run_study(
             tol: *tol,
             stats: report.stats,
             complete: report.failure.is_none(),
+            stopped: report.failure.as_ref().map(|f| {
+                // The diagnosis' first line: what failed, at which time and step.
+                let why = f.to_string();
+                format!("stopped: {}", why.lines().next().unwrap_or_default())
+            }),
             window_errors: Vec::new(),
             error: [f64::NAN; 3],
             order: None,
@@ -475,6 +482,9 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
             table_number(run.error[2]),
             run.order.map_or("-".into(), |o| format!("{o:.2}")),
         )?;
+        if let Some(why) = &run.stopped {
+            writeln!(out, "  └ {why}")?;
+        }
     }
     Ok(())
 }

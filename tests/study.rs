@@ -78,3 +78,45 @@ fn study_reports_order_two_on_the_free_body() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A study whose runs all stop (`decks/stab_diverge.dat`, built to fail: 1e12 N on a steel
+/// cantilever, Newton limited to 10 iterations): each run's row says where it stopped,
+/// the CSVs mark the runs incomplete and hold no number for their errors (no `NaN`, no
+/// `inf`), and the study exits non-zero since no error can be measured.
+#[test]
+fn study_of_runs_that_stop_reports_them_and_writes_no_non_numbers() {
+    let dir = std::env::temp_dir().join(format!("mecano_study_stop_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/stab_diverge.dat");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg("study")
+        .arg(&deck)
+        .args(["--steps", "1e-2,5e-3,2.5e-3", "-o"])
+        .arg(&dir)
+        .output()
+        .expect("binary runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("{stdout}\n{stderr}");
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        stdout.matches("stopped: Newton did not converge").count(),
+        3
+    );
+    assert!(stderr.contains("no run has a measurable error"));
+    let mut rd = csv::Reader::from_path(dir.join("study.csv")).unwrap();
+    let c = rd
+        .headers()
+        .unwrap()
+        .iter()
+        .position(|h| h == "complete")
+        .unwrap();
+    for r in rd.records() {
+        assert_eq!(&r.unwrap()[c], "false");
+    }
+    for f in ["study.csv", "study_windows.csv"] {
+        let text = std::fs::read_to_string(dir.join(f)).unwrap().to_lowercase();
+        assert!(!text.contains("nan") && !text.contains("inf"), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
