@@ -77,6 +77,56 @@ pub struct StudyRun {
     pub error: [f64; 3],
     /// Observed order against the next finer fixed run (fixed runs only).
     pub order: Option<f64>,
+    /// Adaptive runs: what fixed steps (of the first α) cost for the same position error.
+    pub fixed_equivalent: Option<FixedEquivalent>,
+}
+
+/// The CPU time fixed steps take to reach an adaptive run's position error (the measure of
+/// issue 7's target: adaptive CPU over "the best fixed step that reaches the same
+/// accuracy").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixedEquivalent {
+    /// CPU seconds interpolated on the fixed runs' work–precision line, linear in
+    /// `(ln error, ln CPU)` between the two successive ladder runs whose errors bracket the
+    /// adaptive run's; `None` when no pair brackets it.
+    pub interpolated: Option<f64>,
+    /// The cheapest fixed run whose error is at most the adaptive run's: (CPU s, h).
+    pub cheapest: Option<(f64, f64)>,
+}
+
+/// The error the diagram and the adaptive comparison use: 0 (positions), or 1 (rotations)
+/// when no run has a position error (the chosen nodes do not translate).
+fn compared_quantity(runs: &[StudyRun]) -> usize {
+    usize::from(
+        runs.iter()
+            .all(|x| x.error[0] == 0.0 || !x.error[0].is_finite()),
+    )
+}
+
+/// [`FixedEquivalent`] of an error `e` among fixed runs `(h, error, CPU s)`, coarsest first
+/// (runs with a zero, NaN or infinite error — the reference, stopped runs — are ignored).
+pub fn fixed_equivalent(fixed: &[(f64, f64, f64)], e: f64) -> FixedEquivalent {
+    let runs: Vec<(f64, f64, f64)> = fixed
+        .iter()
+        .copied()
+        .filter(|r| r.1 > 0.0 && r.1.is_finite() && r.2 > 0.0)
+        .collect();
+    let interpolated = runs.windows(2).find_map(|w| {
+        let ((_, e0, c0), (_, e1, c1)) = (w[0], w[1]);
+        (e0 >= e && e >= e1 && e0 > e1).then(|| {
+            let theta = (e0.ln() - e.ln()) / (e0.ln() - e1.ln());
+            (c0.ln() + theta * (c1.ln() - c0.ln())).exp()
+        })
+    });
+    let cheapest = runs
+        .iter()
+        .filter(|r| r.1 <= e)
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+        .map(|r| (r.2, r.0));
+    FixedEquivalent {
+        interpolated,
+        cheapest,
+    }
 }
 
 /// The study's result.
@@ -259,6 +309,7 @@ pub fn run_study(
             window_errors: Vec::new(),
             error: [f64::NAN; 3],
             order: None,
+            fixed_equivalent: None,
         });
         records.push(rec.recs);
     }
@@ -337,6 +388,19 @@ pub fn run_study(
             runs[i].order = Some((na / nb).log2() / (steps[i] / steps[i + 1]).log2());
         }
     }
+    // Adaptive runs against the fixed runs of the first α at the same error (position, or
+    // rotation where the chosen nodes do not translate, as in the diagram).
+    let c = compared_quantity(&runs);
+    let fixed: Vec<(f64, f64, f64)> = runs[..nfix]
+        .iter()
+        .filter(|r| r.complete)
+        .map(|r| (r.h, r.error[c], r.stats.cpu_seconds))
+        .collect();
+    for run in runs.iter_mut().filter(|r| r.tol.is_some() && r.complete) {
+        if run.error[c].is_finite() {
+            run.fixed_equivalent = Some(fixed_equivalent(&fixed, run.error[c]));
+        }
+    }
     let report = StudyReport {
         runs,
         windows,
@@ -388,8 +452,14 @@ pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
         "error_rotation",
         "error_velocity",
         "observed_order",
+        "fixed_cpu_same_error",
+        "cheapest_fixed_cpu_within_error",
+        "cheapest_fixed_h_within_error",
     ])?;
     for run in &r.runs {
+        let fe = run.fixed_equivalent;
+        let interpolated = fe.and_then(|f| f.interpolated);
+        let cheapest = fe.and_then(|f| f.cheapest);
         w.write_record([
             run.label.clone(),
             format!("{:e}", run.h),
@@ -405,6 +475,9 @@ pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
             csv_number(run.error[1]),
             csv_number(run.error[2]),
             run.order.map_or(String::new(), |o| format!("{o:.3}")),
+            interpolated.map_or(String::new(), |c| format!("{c:.4}")),
+            cheapest.map_or(String::new(), |c| format!("{:.4}", c.0)),
+            cheapest.map_or(String::new(), |c| format!("{:e}", c.1)),
         ])?;
     }
     w.flush()?;
@@ -485,6 +558,46 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
         if let Some(why) = &run.stopped {
             writeln!(out, "  └ {why}")?;
         }
+    }
+    let adaptive: Vec<&StudyRun> = r
+        .runs
+        .iter()
+        .filter(|x| x.fixed_equivalent.is_some())
+        .collect();
+    let (c, unit) = match compared_quantity(&r.runs) {
+        0 => (0, "m"),
+        _ => (1, "rad"),
+    };
+    if !adaptive.is_empty() {
+        writeln!(
+            out,
+            "adaptive against fixed steps at the same {} error (ratio = adaptive CPU / fixed CPU):",
+            ["position", "rotation"][c]
+        )?;
+    }
+    for run in adaptive {
+        let Some(fe) = run.fixed_equivalent else {
+            continue;
+        };
+        let cpu = run.stats.cpu_seconds;
+        let interp = fe
+            .interpolated
+            .map_or("no fixed pair brackets its error".to_string(), |f| {
+                format!("fixed steps {f:.3} s (interpolated), ratio {:.2}", cpu / f)
+            });
+        let cheapest = fe
+            .cheapest
+            .map_or("no fixed run is as accurate".to_string(), |(f, h)| {
+                format!(
+                    "cheapest fixed run as accurate h = {h:.3e}: {f:.3} s, ratio {:.2}",
+                    cpu / f
+                )
+            });
+        writeln!(
+            out,
+            "  {:<30} {:.2e} {unit} in {cpu:.3} s: {interp}; {cheapest}",
+            run.label, run.error[c]
+        )?;
     }
     Ok(())
 }
@@ -593,11 +706,7 @@ pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
     use plotters::prelude::*;
     crate::plot::ensure_font();
     // Position error, or the rotation error when the chosen nodes do not translate.
-    let c = usize::from(
-        r.runs
-            .iter()
-            .all(|x| x.error[0] == 0.0 || !x.error[0].is_finite()),
-    );
+    let c = compared_quantity(&r.runs);
     let pts: Vec<(f64, f64)> = r
         .runs
         .iter()
@@ -744,10 +853,32 @@ fn cpu_label(v: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{csv_number, table_number};
+    use super::{csv_number, fixed_equivalent, table_number};
 
     /// A quantity without a converged window (NaN) or a run that stopped (infinite error)
     /// is an empty CSV field and a word in the table, never a NaN or `inf` in a file.
+    /// On a work–precision line error = h², CPU = 1/h (order 2, cost ∝ steps) the
+    /// interpolation is exact in (ln error, ln CPU): an error h*² costs 1/h*. The cheapest
+    /// run within an error is the coarsest that reaches it; the reference (error 0) and a
+    /// stopped run (infinite error) are ignored; an error below every run's has no
+    /// bracketing pair.
+    #[test]
+    fn fixed_equivalent_interpolates_the_work_precision_line() {
+        let ladder: Vec<(f64, f64, f64)> = [8e-3, 4e-3, 2e-3, 1e-3]
+            .iter()
+            .map(|&h| (h, h * h, 1.0 / h))
+            .chain([(5e-4, 0.0, 2000.0), (1e-2, f64::INFINITY, 1.0)])
+            .collect();
+        let h_star: f64 = 3e-3;
+        let f = fixed_equivalent(&ladder, h_star * h_star);
+        let c = f.interpolated.expect("bracketed");
+        assert!((c - 1.0 / h_star).abs() < 1e-9 * c, "{c}");
+        assert_eq!(f.cheapest, Some((500.0, 2e-3)));
+        let f = fixed_equivalent(&ladder, 1e-7);
+        assert_eq!(f.interpolated, None);
+        assert_eq!(f.cheapest, None);
+    }
+
     #[test]
     fn errors_that_are_not_numbers_are_not_written_as_numbers() {
         assert_eq!(csv_number(f64::NAN), "");
