@@ -1,32 +1,49 @@
 //! No heap allocation in the step loop after the first steps (issue 7, "a fast step"):
 //! a counting global allocator wraps the system one and counts every allocation and
-//! reallocation while the pendulum of `decks/pendulum.dat` takes 50 steps.
+//! reallocation while the pendulum of `decks/pendulum.dat` takes 50 steps — without
+//! output, and writing every node and element at every step.
+
+use mecano::solver::{Observer, Snapshot};
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::cell::Cell;
 
 struct Counting;
 
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-static COUNTING: AtomicBool = AtomicBool::new(false);
+// Per thread: the tests of this file run in parallel, and each counts its own thread's
+// allocations only (const-initialised thread-locals do not allocate).
+thread_local! {
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+    static ALLOCS: Cell<u64> = const { Cell::new(0) };
+}
+
+fn count() {
+    let on = COUNTING.try_with(Cell::get).unwrap_or(false);
+    if on {
+        let _ = ALLOCS.try_with(|a| a.set(a.get() + 1));
+    }
+}
+
+/// Counts the allocations `f` makes on this thread.
+fn allocations_in<T>(f: impl FnOnce() -> T) -> (T, u64) {
+    ALLOCS.with(|a| a.set(0));
+    COUNTING.with(|c| c.set(true));
+    let out = f();
+    COUNTING.with(|c| c.set(false));
+    (out, ALLOCS.with(Cell::get))
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
+        count();
         unsafe { System.alloc(layout) }
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
+        count();
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
+        count();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
@@ -50,13 +67,42 @@ fn the_step_loop_does_not_allocate() {
     for _ in 0..5 {
         integ.try_step(h).expect("step");
     }
-    COUNTING.store(true, Ordering::SeqCst);
-    let mut ok = true;
-    for _ in 0..50 {
-        ok &= integ.try_step(h).is_ok();
-    }
-    COUNTING.store(false, Ordering::SeqCst);
-    let n = ALLOCS.load(Ordering::SeqCst);
+    let (ok, n) = allocations_in(|| (0..50).all(|_| integ.try_step(h).is_ok()));
     assert!(ok, "a step failed");
     assert_eq!(n, 0, "{n} heap allocations in 50 steps");
+}
+
+/// Writing the histories allocates nothing either: every node and element of the pendulum
+/// (hinge, universal joint, 20 beams, the CAME contact, two masses) and the energies at
+/// each of the 50 steps, through `output::Writer` (csv, ryu, one reused row buffer).
+#[test]
+fn writing_every_node_and_element_every_step_does_not_allocate() {
+    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/decks/pendulum.dat"));
+    let mut model = mecano::deck::load_deck(path).expect("seed deck");
+    model.output.nodes = mecano::model::Selection::All;
+    model.output.elements = mecano::model::Selection::All;
+    model.output.every = 1;
+    let dir = std::env::temp_dir().join(format!("mecano_alloc_{}", std::process::id()));
+    let mut integ = mecano::solver::prepare(&model).expect("prepare");
+    integ.initialize().expect("initial accelerations");
+    let mut writer =
+        mecano::output::Writer::create(&dir, "pendulum.dat", &model, &integ.sys).expect("files");
+    let h = 1e-4;
+    let mut step = 0;
+    let mut go = |integ: &mut mecano::solver::Integrator, writer: &mut mecano::output::Writer| {
+        step += 1;
+        let ok = integ.try_step(h).is_ok();
+        writer
+            .state(&Snapshot { integ, step, h })
+            .expect("row written");
+        ok
+    };
+    for _ in 0..5 {
+        assert!(go(&mut integ, &mut writer));
+    }
+    let (ok, n) = allocations_in(|| (0..50).all(|_| go(&mut integ, &mut writer)));
+    drop(writer);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(ok, "a step failed");
+    assert_eq!(n, 0, "{n} heap allocations in 50 steps with their output");
 }

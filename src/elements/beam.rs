@@ -318,15 +318,19 @@ impl Element for Beam {
         .collect()
     }
 
-    fn output_row(&self, _ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) -> Vec<f64> {
+    fn write_output_row(
+        &self,
+        _ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        row: &mut Vec<f64>,
+    ) {
         let (g, k) = self.strains(&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
         let n = g.component_mul(&self.props.cn);
         let m = k.component_mul(&self.props.cm);
-        let mut row = Vec::with_capacity(12);
         for v in [n, m, g, k] {
             row.extend_from_slice(v.as_slice());
         }
-        row
     }
 }
 

@@ -602,10 +602,16 @@ impl Element for Came {
         .collect()
     }
 
-    fn output_row(&self, _ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) -> Vec<f64> {
+    fn write_output_row(
+        &self,
+        _ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        row: &mut Vec<f64>,
+    ) {
         let Some(st) = self.state(nodes) else {
             // Apart: the gap still, from a projection (output only, once per step).
-            return self.row(nodes, &self.full_state(nodes), 0.0, 0.0);
+            return self.row(nodes, &self.full_state(nodes), 0.0, 0.0, row);
         };
         let p = self.applied(&st);
         let ft = if self.mu > 0.0 && p != 0.0 {
@@ -614,7 +620,7 @@ impl Element for Came {
         } else {
             0.0
         };
-        self.row(nodes, &st, p, ft)
+        self.row(nodes, &st, p, ft, row);
     }
 
     fn summary(&self) -> Option<serde_json::Value> {
@@ -790,7 +796,14 @@ fn hermite_root(g0: f64, gd0: f64, g1: f64, gd1: f64, h: f64) -> Option<f64> {
 }
 
 impl Came {
-    fn row(&self, nodes: &[NodeState], st: &ContactState<f64>, p: f64, ft: f64) -> Vec<f64> {
+    fn row(
+        &self,
+        nodes: &[NodeState],
+        st: &ContactState<f64>,
+        p: f64,
+        ft: f64,
+        row: &mut Vec<f64>,
+    ) {
         let (c_pt, eta, zeta) = if self.s == 0 {
             (
                 st.on_surface,
@@ -805,7 +818,7 @@ impl Came {
             )
         };
         let active = if p != 0.0 { 1.0 } else { 0.0 };
-        vec![
+        row.extend_from_slice(&[
             active,
             st.gap,
             st.gap_rate,
@@ -816,7 +829,7 @@ impl Came {
             c_pt.z,
             eta,
             zeta,
-        ]
+        ]);
     }
 
     /// `ω = √(k / m_eff)`, `m_eff = P / q̈_n`, when the converged state allows it.

@@ -497,19 +497,27 @@ impl Joint {
         nodes: &[NodeState],
         lambda: &[f64],
     ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
-        let m = self.m_pair();
-        self.pairs
-            .iter()
-            .enumerate()
-            .map(|(k, pair)| {
-                let (s1, s2) = (&nodes[self.nodes[pair.a]], &nodes[self.nodes[pair.b]]);
-                let lam = lambda.get(k * m..(k + 1) * m).unwrap_or(&[]);
-                let (_, g) = self.forces_f64(pair, s1, s2, ctx, lam);
-                let f = -Vector3::new(g[6], g[7], g[8]);
-                let mom = s2.r * -Vector3::new(g[9], g[10], g[11]) - (s2.r * pair.c2).cross(&f);
-                (f, mom)
-            })
+        (0..self.pairs.len())
+            .map(|k| self.reaction(k, ctx, nodes, lambda))
             .collect()
+    }
+
+    /// The reaction of pair `k` (see [`Self::reactions`]).
+    fn reaction(
+        &self,
+        k: usize,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let m = self.m_pair();
+        let pair = &self.pairs[k];
+        let (s1, s2) = (&nodes[self.nodes[pair.a]], &nodes[self.nodes[pair.b]]);
+        let lam = lambda.get(k * m..(k + 1) * m).unwrap_or(&[]);
+        let (_, g) = self.forces_f64(pair, s1, s2, ctx, lam);
+        let f = -Vector3::new(g[6], g[7], g[8]);
+        let mom = s2.r * -Vector3::new(g[9], g[10], g[11]) - (s2.r * pair.c2).cross(&f);
+        (f, mom)
     }
 
     /// Joint angles: HINGE relative angle in (−π, π]; UJOINT `(θ₁, θ₂, cos bend)`.
@@ -657,22 +665,31 @@ impl Element for Joint {
         }
     }
 
-    fn output_row(&self, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64]) -> Vec<f64> {
+    fn write_output_row(
+        &self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+        row: &mut Vec<f64>,
+    ) {
         let a = self.angles(nodes);
-        let mut row = match &self.kind {
-            JointType::Hinge { .. } => vec![a[0]],
-            JointType::UJoint { .. } => vec![a[0], a[1], a[2].clamp(-1.0, 1.0).acos()],
+        match &self.kind {
+            JointType::Hinge { .. } => row.push(a[0]),
+            JointType::UJoint { .. } => {
+                row.extend_from_slice(&[a[0], a[1], a[2].clamp(-1.0, 1.0).acos()]);
+            }
             JointType::Prismatic { a: ax, .. } => {
                 let (s1, s2) = (&nodes[self.nodes[0]], &nodes[self.nodes[1]]);
                 let d = s2.x + s2.r * self.pairs[0].c2 - s1.x;
-                vec![d.dot(&(s1.r * ax))]
+                row.push(d.dot(&(s1.r * ax)));
             }
-            _ => vec![],
-        };
-        for (f, m) in self.reactions(ctx, nodes, lambda) {
-            row.extend(f.iter().chain(m.iter()).copied());
+            _ => {}
         }
-        row
+        for k in 0..self.pairs.len() {
+            let (f, m) = self.reaction(k, ctx, nodes, lambda);
+            row.extend_from_slice(f.as_slice());
+            row.extend_from_slice(m.as_slice());
+        }
     }
 
     fn constraint_violation(&self, nodes: &[NodeState]) -> f64 {

@@ -320,9 +320,23 @@ pub trait Element: Send + Sync {
         Vec::new()
     }
 
-    /// Values of this element's output row, matching [`Element::output_header`].
-    fn output_row(&self, _ctx: &EvalContext, _nodes: &[NodeState], _lambda: &[f64]) -> Vec<f64> {
-        Vec::new()
+    /// Appends the values of this element's output row, matching
+    /// [`Element::output_header`], to `row` (the output writer reuses one buffer: no
+    /// allocation per row).
+    fn write_output_row(
+        &self,
+        _ctx: &EvalContext,
+        _nodes: &[NodeState],
+        _lambda: &[f64],
+        _row: &mut Vec<f64>,
+    ) {
+    }
+
+    /// This element's output row as a new vector (see [`Element::write_output_row`]).
+    fn output_row(&self, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64]) -> Vec<f64> {
+        let mut row = Vec::new();
+        self.write_output_row(ctx, nodes, lambda, &mut row);
+        row
     }
 
     /// Largest constraint violation (position m, angle rad) at the state; 0 for elements

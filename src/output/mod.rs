@@ -237,7 +237,7 @@ impl Writer {
             let row = &mut self.row;
             row.clear();
             row.push(t);
-            row.extend(el.output_row(&ctx, &integ.nodes, lam));
+            el.write_output_row(&ctx, &integ.nodes, lam, row);
             st.row(row)?;
         }
         let e = integ.energies();
