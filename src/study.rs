@@ -559,10 +559,10 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
             writeln!(out, "  └ {why}")?;
         }
     }
-    let adaptive: Vec<&StudyRun> = r
+    let adaptive: Vec<(&StudyRun, FixedEquivalent)> = r
         .runs
         .iter()
-        .filter(|x| x.fixed_equivalent.is_some())
+        .filter_map(|x| Some((x, x.fixed_equivalent?)))
         .collect();
     let (c, unit) = match compared_quantity(&r.runs) {
         0 => (0, "m"),
@@ -575,10 +575,7 @@ pub fn print_table(r: &StudyReport, out: &mut dyn Write) -> io::Result<()> {
             ["position", "rotation"][c]
         )?;
     }
-    for run in adaptive {
-        let Some(fe) = run.fixed_equivalent else {
-            continue;
-        };
+    for (run, fe) in adaptive {
         let cpu = run.stats.cpu_seconds;
         let interp = fe
             .interpolated
