@@ -1,0 +1,335 @@
+//! Stage 2, LOADS, INITIAL, ANALYSIS and OUTPUT.
+
+use super::cursor::*;
+use super::*;
+
+impl Builder<'_> {
+    // ---------------------------------------------------------------- LOADS
+    pub(super) fn load(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "LOADS card");
+        let (kw, ks) =
+            c.expect_keyword(&["GRAVITY", "FORCE", "MOMENT"], "GRAVITY, FORCE or MOMENT")?;
+        c.ctx = kw.to_string();
+        if kw == "GRAVITY" {
+            let (g, _, _) = c.vec3("GRAVITY")?;
+            c.finish()?;
+            if let Some((_, first)) = self.gravity {
+                let first_line = self.line(first);
+                return Err(DeckError::new(
+                    K::RepeatedCard {
+                        keyword: "GRAVITY".into(),
+                        first_line,
+                    },
+                    ks,
+                ));
+            }
+            self.gravity = Some((g, span));
+            return Ok(());
+        }
+        let (n, ns) = c.uint("node number")?;
+        let (value, _, _) = c.vec3(kw)?;
+        let mut function = None;
+        if c.keyword(&["FUNCTION"]).is_some() {
+            let (f, fs) = c.uint("function number")?;
+            function = Some(self.function_ref(f, fs)?);
+        }
+        c.finish()?;
+        let node = self.node_ref(n, ns)?;
+        self.loads.push(NodalLoad {
+            node,
+            moment: kw == "MOMENT",
+            value,
+            function,
+            span,
+        });
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- INITIAL
+    /// `<n> [TO <n2>] [V vx vy vz] [W wx wy wz] [ABOUT cx cy cz]`: with ABOUT, each node
+    /// gets the rigid-body velocity `V + W × (x − c)`.
+    pub(super) fn initial(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "INITIAL card");
+        let (first, fs) = c.uint("node number")?;
+        let mut last = first;
+        let mut last_span = fs;
+        if c.keyword(&["TO"]).is_some() {
+            (last, last_span) = c.uint("last node number")?;
+            if last < first {
+                return Err(DeckError::new(
+                    K::BadGeneration {
+                        first,
+                        last,
+                        reason: "the last number must not be smaller than the first".into(),
+                    },
+                    Span::new(fs.start, last_span.end),
+                ));
+            }
+            generation_size(first, last, Span::new(fs.start, last_span.end))?;
+        }
+        let mut v = Vector3::zeros();
+        let mut w = Vector3::zeros();
+        let mut about = None;
+        if c.keyword(&["V"]).is_some() {
+            v = c.vec3("V")?.0;
+        }
+        if c.keyword(&["W"]).is_some() {
+            w = c.vec3("W")?.0;
+        }
+        if c.keyword(&["ABOUT"]).is_some() {
+            about = Some(c.vec3("ABOUT")?.0);
+        }
+        c.finish()?;
+        for id in first..=last {
+            let s = if id == first { fs } else { last_span };
+            let node = self.node_ref(id, s)?;
+            let x = self
+                .nodes
+                .get(&node)
+                .map_or_else(Vector3::zeros, |n| n.position);
+            let vel = match about {
+                Some(c0) => v + w.cross(&(x - c0)),
+                None => v,
+            };
+            self.initial.push(InitialVelocity {
+                node,
+                velocity: vel,
+                angular: w,
+                span,
+            });
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- ANALYSIS
+    pub(super) fn analysis(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "ANALYSIS card");
+        c.skip();
+        let (kind, _) = c.expect_keyword(&["DYNAMIC", "STATIC"], "DYNAMIC or STATIC")?;
+        c.ctx = format!("ANALYSIS {kind}");
+        let kws: &[&'static str] = if kind == "DYNAMIC" {
+            &[
+                "ALPHA", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT",
+                "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
+            ]
+        } else {
+            &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
+        };
+        let mut seen = Seen::default();
+        let mut newton = NewtonSettings::default();
+        let mut alpha = -0.1;
+        let (mut step, mut end, mut min, mut max) = (None, None, None, None);
+        let (mut tolpos, mut tolrot, mut growth, mut steps) = (None, None, 2.0, 1);
+        let mut adaptive = None;
+        let pos = |v: f64| v > 0.0;
+        while let Some(t) = c.peek() {
+            let Some((kw, ks)) = c.keyword(kws) else {
+                return Err(c.unexpected(t, &expected_list(kws)));
+            };
+            seen.add(kw, ks, &c.ctx)?;
+            match kw {
+                "ALPHA" => {
+                    alpha = c.number_in("ALPHA (HHT)", "-1/3 <= alpha <= 0", |v| {
+                        (-1.0 / 3.0 - 1e-12..=0.0).contains(&v)
+                    })?
+                }
+                "STEP" => step = Some(c.number("STEP (time step)")?),
+                "END" => end = Some(c.number_in("END (end time)", "> 0 s", pos)?),
+                "MINSTEP" => min = Some(c.number("MINSTEP (smallest step)")?),
+                "MAXSTEP" => max = Some(c.number("MAXSTEP (largest step)")?),
+                "ADAPTIVE" => adaptive = Some(ks),
+                "TOLPOS" => tolpos = Some(c.number_in("TOLPOS", "> 0 m", pos)?),
+                "TOLROT" => tolrot = Some(c.number_in("TOLROT", "> 0 rad", pos)?),
+                "GROWTH" => growth = c.number_in("GROWTH", ">= 1", |v| v >= 1.0)?,
+                "TOL" => newton.tol_residual = c.number_in("TOL", "> 0", pos)?,
+                "TOLINC" => newton.tol_increment = c.number_in("TOLINC", "> 0", pos)?,
+                "MAXIT" => {
+                    let (n, s) = c.uint("MAXIT")?;
+                    if n < 1 {
+                        return Err(out_of_range("MAXIT", "0", ">= 1", s));
+                    }
+                    newton.max_iterations = n;
+                }
+                "NEWTON" => {
+                    let (v, _) = c.expect_keyword(&["FULL", "MODIFIED"], "FULL or MODIFIED")?;
+                    newton.modified = v == "MODIFIED";
+                }
+                _ => {
+                    let (n, s) = c.uint("STEPS")?;
+                    if n < 1 {
+                        return Err(out_of_range("STEPS", "0", ">= 1", s));
+                    }
+                    steps = n;
+                }
+            }
+        }
+        let analysis = if kind == "STATIC" {
+            Analysis::Static { steps, newton }
+        } else {
+            let miss = |what: &str| {
+                DeckError::new(
+                    K::MissingKeyword {
+                        context: c.ctx.clone(),
+                        expected: what.into(),
+                    },
+                    c.end_span(),
+                )
+            };
+            let (h, hs, ht) = step.ok_or_else(|| miss("STEP <time step>"))?;
+            if h <= 0.0 {
+                return Err(out_of_range("STEP (time step)", ht, "> 0 s", hs));
+            }
+            let end = end.ok_or_else(|| miss("END <end time>"))?;
+            let min_step = match min {
+                None => h / 1024.0,
+                Some((v, s, t)) if v <= 0.0 || v > h => {
+                    return Err(out_of_range("MINSTEP", t, "0 < MINSTEP <= STEP", s));
+                }
+                Some((v, _, _)) => v,
+            };
+            let max_step = match max {
+                None => h,
+                Some((v, s, t)) if v < h => {
+                    return Err(out_of_range("MAXSTEP", t, "MAXSTEP >= STEP", s));
+                }
+                Some((v, _, _)) => v,
+            };
+            let adaptive = match (adaptive, tolpos, tolrot) {
+                (Some(_), Some(p), Some(r)) => Some(Adaptive {
+                    tol_position: p,
+                    tol_rotation: r,
+                    max_growth: growth,
+                }),
+                (Some(_), None, _) => return Err(miss("TOLPOS <m> after ADAPTIVE")),
+                (Some(_), _, None) => return Err(miss("TOLROT <rad> after ADAPTIVE")),
+                (None, _, _) => {
+                    for kw in ["TOLPOS", "TOLROT", "GROWTH"] {
+                        if seen.has(kw) {
+                            return Err(DeckError::new(
+                                K::MissingKeyword {
+                                    context: format!("{kw} in {}", c.ctx),
+                                    expected: "ADAPTIVE".into(),
+                                },
+                                c.end_span(),
+                            ));
+                        }
+                    }
+                    None
+                }
+            };
+            Analysis::Dynamic {
+                alpha,
+                step: h,
+                end,
+                min_step,
+                max_step,
+                adaptive,
+                newton,
+            }
+        };
+        if let Some((_, first)) = self.analysis {
+            let first_line = self.line(first);
+            return Err(DeckError::new(
+                K::RepeatedCard {
+                    keyword: "ANALYSIS".into(),
+                    first_line,
+                },
+                span,
+            ));
+        }
+        self.analysis = Some((analysis, span));
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- OUTPUT
+    pub(super) fn output(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "OUTPUT card");
+        c.skip();
+        const KW: [&str; 5] = ["NODES", "ELEMENTS", "EVERY", "DIR", "VTK"];
+        let mut seen = Seen::default();
+        let mut out = OutputRequest::default();
+        while let Some(t) = c.peek() {
+            let Some((kw, ks)) = c.keyword(&KW) else {
+                return Err(c.unexpected(t, &expected_list(&KW)));
+            };
+            seen.add(kw, ks, &c.ctx)?;
+            match kw {
+                "NODES" | "ELEMENTS" => {
+                    let what = if kw == "NODES" { "node" } else { "element" };
+                    let sel = if c.keyword(&["ALL"]).is_some() {
+                        Selection::All
+                    } else if c.keyword(&["NONE"]).is_some() {
+                        Selection::None
+                    } else {
+                        let mut ids = Vec::new();
+                        while c.next_is_number() {
+                            ids.push(c.uint(&format!("{what} number"))?);
+                        }
+                        if ids.is_empty() {
+                            let e = format!("ALL, NONE or {what} numbers after {kw}");
+                            return Err(match c.peek() {
+                                Some(t) => c.unexpected(t, &e),
+                                None => c.missing(&e),
+                            });
+                        }
+                        Selection::List(ids)
+                    };
+                    match sel {
+                        Selection::List(ids) if kw == "NODES" => {
+                            let mut v = Vec::new();
+                            for (id, s) in ids {
+                                v.push(self.node_ref(id, s)?);
+                            }
+                            out.nodes = Selection::List(v);
+                        }
+                        Selection::List(ids) => {
+                            let mut v = Vec::new();
+                            for (id, s) in ids {
+                                if !self.elements.contains_key(&ElementId(id)) {
+                                    return Err(DeckError::new(
+                                        K::Undefined {
+                                            what: "element",
+                                            id,
+                                        },
+                                        s,
+                                    ));
+                                }
+                                v.push(ElementId(id));
+                            }
+                            out.elements = Selection::List(v);
+                        }
+                        Selection::All if kw == "NODES" => out.nodes = Selection::All,
+                        Selection::All => out.elements = Selection::All,
+                        Selection::None if kw == "NODES" => out.nodes = Selection::None,
+                        Selection::None => out.elements = Selection::None,
+                    }
+                }
+                "EVERY" => {
+                    let (n, s) = c.uint("EVERY (output interval in steps)")?;
+                    if n < 1 {
+                        return Err(out_of_range("EVERY", "0", ">= 1", s));
+                    }
+                    out.every = n;
+                }
+                "DIR" => out.dir = Some(c.next("directory after DIR")?.text.to_string()),
+                _ => out.vtk = true,
+            }
+        }
+        if let Some((_, first)) = self.output {
+            let first_line = self.line(first);
+            return Err(DeckError::new(
+                K::RepeatedCard {
+                    keyword: "OUTPUT".into(),
+                    first_line,
+                },
+                span,
+            ));
+        }
+        self.output = Some((out, span));
+        Ok(())
+    }
+}

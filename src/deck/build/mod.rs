@@ -1,0 +1,215 @@
+//! Stage 2 (meaning): cards → [`Model`]. References resolved, defaults applied,
+//! every value checked; all errors are gathered.
+
+mod analysis;
+mod cursor;
+mod elements;
+mod nodes;
+mod properties;
+
+use super::cards::{Card, Section};
+use super::error::{DeckError, DeckErrorKind as K, line_col};
+use super::lex::Token;
+use crate::model::{
+    Adaptive, Analysis, CameData, Element, ElementId, ElementKind, Fixity, Function, FunctionDef,
+    FunctionId, InitialVelocity, Material, MaterialId, Model, NewtonSettings, NodalLoad, Node,
+    NodeId, OutputRequest, PlacedProfile, Profile, Section as Sec, SectionId, Selection, Span,
+};
+use indexmap::IndexMap;
+use nalgebra::{Matrix3, Vector3};
+
+type R<T> = Result<T, DeckError>;
+
+/// Normalises `v`; `None` when zero or not finite. A vector already of unit length (to
+/// 1e-12) is kept as written so that writing and re-reading a model is exact.
+pub(crate) fn unit(v: Vector3<f64>) -> Option<Vector3<f64>> {
+    let n = v.norm();
+    if !n.is_finite() || n == 0.0 || !v.iter().all(|c| c.is_finite()) {
+        return None;
+    }
+    if (n - 1.0).abs() <= 1e-12 {
+        Some(v)
+    } else {
+        Some(v / n)
+    }
+}
+
+/// Builds the model, collecting every error.
+struct Builder<'s> {
+    src: &'s str,
+    errors: Vec<DeckError>,
+    title: Option<(String, Span)>,
+    materials: IndexMap<MaterialId, Material>,
+    sections: IndexMap<SectionId, Sec>,
+    functions: IndexMap<FunctionId, FunctionDef>,
+    nodes: IndexMap<NodeId, Node>,
+    elements: IndexMap<ElementId, Element>,
+    loads: Vec<NodalLoad>,
+    gravity: Option<(Vector3<f64>, Span)>,
+    initial: Vec<InitialVelocity>,
+    analysis: Option<(Analysis, Span)>,
+    output: Option<(OutputRequest, Span)>,
+}
+
+impl<'s> Builder<'s> {
+    fn line(&self, span: Span) -> usize {
+        line_col(self.src, span.start).0
+    }
+
+    fn push<T>(&mut self, r: R<T>) -> Option<T> {
+        match r {
+            Ok(v) => Some(v),
+            Err(e) => {
+                self.errors.push(e);
+                None
+            }
+        }
+    }
+
+    fn duplicate(&mut self, what: &'static str, id: u32, first: Span, span: Span) {
+        let first_line = self.line(first);
+        self.errors.push(DeckError::new(
+            K::Duplicate {
+                what,
+                id,
+                first_line,
+            },
+            span,
+        ));
+    }
+
+    fn node_ref(&self, id: u32, span: Span) -> R<NodeId> {
+        if self.nodes.contains_key(&NodeId(id)) {
+            Ok(NodeId(id))
+        } else {
+            Err(DeckError::new(K::Undefined { what: "node", id }, span))
+        }
+    }
+
+    fn function_ref(&self, id: u32, span: Span) -> R<FunctionId> {
+        if self.functions.contains_key(&FunctionId(id)) {
+            Ok(FunctionId(id))
+        } else {
+            Err(DeckError::new(
+                K::Undefined {
+                    what: "function",
+                    id,
+                },
+                span,
+            ))
+        }
+    }
+}
+
+fn conflict(first: &str, second: &str, ctx: &str, span: Span) -> DeckError {
+    DeckError::new(
+        K::Conflict {
+            first: first.into(),
+            second: second.into(),
+            context: ctx.into(),
+        },
+        span,
+    )
+}
+
+/// Stage 2: builds the model from the cards; `errors` already holds stage-1 errors.
+/// Returns the model only when no error at all was found.
+pub(crate) fn build_model(
+    src: &str,
+    cards: &[Card<'_>],
+    errors: Vec<DeckError>,
+    empty: bool,
+) -> Result<Model, Vec<DeckError>> {
+    let mut b = Builder {
+        src,
+        errors,
+        title: None,
+        materials: IndexMap::new(),
+        sections: IndexMap::new(),
+        functions: IndexMap::new(),
+        nodes: IndexMap::new(),
+        elements: IndexMap::new(),
+        loads: Vec::new(),
+        gravity: None,
+        initial: Vec::new(),
+        analysis: None,
+        output: None,
+    };
+    let of = |s: Section| cards.iter().filter(move |c| c.section == s);
+    // Definitions first (in dependency order), references after: a deck may list its
+    // sections in any order.
+    for c in of(Section::Title) {
+        b.title(c);
+    }
+    for c in of(Section::Materials) {
+        let r = b.material(c);
+        b.push(r);
+    }
+    for c in of(Section::Sections) {
+        let r = b.section(c);
+        b.push(r);
+    }
+    for c in of(Section::Functions) {
+        let r = b.function(c);
+        b.push(r);
+    }
+    let is_fix = |c: &&Card<'_>| c.tokens.first().is_some_and(|t| t.is_kw("FIX"));
+    for c in of(Section::Nodes).filter(|c| !is_fix(c)) {
+        let r = b.node(c);
+        b.push(r);
+    }
+    for c in of(Section::Nodes).filter(is_fix) {
+        let r = b.fix_card(c);
+        b.push(r);
+    }
+    for c in of(Section::Elements) {
+        let r = b.element(c);
+        b.push(r);
+    }
+    for c in of(Section::Loads) {
+        let r = b.load(c);
+        b.push(r);
+    }
+    for c in of(Section::Initial) {
+        let r = b.initial(c);
+        b.push(r);
+    }
+    for c in of(Section::Analysis) {
+        let r = b.analysis(c);
+        b.push(r);
+    }
+    for c in of(Section::Output) {
+        let r = b.output(c);
+        b.push(r);
+    }
+    let Some((analysis, _)) = b.analysis.take() else {
+        let kind = if empty {
+            K::EmptyDeck
+        } else {
+            K::MissingAnalysis
+        };
+        let at = if kind == K::EmptyDeck { 0 } else { src.len() };
+        // The analysis may exist but be malformed: then its own error says so.
+        let malformed = cards.iter().any(|c| c.section == Section::Analysis);
+        if !malformed {
+            b.errors.push(DeckError::new(kind, Span::new(at, at)));
+        }
+        return Err(b.errors);
+    };
+    if !b.errors.is_empty() {
+        return Err(b.errors);
+    }
+    Ok(Model {
+        title: b.title.map_or_else(|| "untitled".to_string(), |t| t.0),
+        nodes: b.nodes,
+        materials: b.materials,
+        sections: b.sections,
+        functions: b.functions,
+        elements: b.elements,
+        loads: b.loads,
+        gravity: b.gravity.map(|g| g.0),
+        initial: b.initial,
+        analysis,
+        output: b.output.map(|o| o.0).unwrap_or_default(),
+    })
+}

@@ -1,0 +1,234 @@
+//! Stage 2, definitions: TITLE, MATERIALS, SECTIONS, FUNCTIONS.
+
+use super::cursor::*;
+use super::*;
+
+impl Builder<'_> {
+    // ---------------------------------------------------------------- TITLE
+    pub(super) fn title(&mut self, card: &Card<'_>) {
+        let span = card.span();
+        if let Some((_, first)) = &self.title {
+            let first_line = self.line(*first);
+            self.errors.push(DeckError::new(
+                K::RepeatedCard {
+                    keyword: "TITLE".into(),
+                    first_line,
+                },
+                span,
+            ));
+            return;
+        }
+        let text = match (card.tokens.get(1), card.tokens.last()) {
+            (Some(a), Some(b)) if card.tokens.len() > 1 => {
+                let raw = self.src.get(a.span.start..b.span.end).unwrap_or("");
+                if raw.contains('\n') {
+                    let words: Vec<&str> = card.tokens[1..].iter().map(|t| t.text).collect();
+                    words.join(" ")
+                } else {
+                    raw.to_string()
+                }
+            }
+            _ => String::new(),
+        };
+        self.title = Some((text, span));
+    }
+
+    // ---------------------------------------------------------------- MATERIALS
+    pub(super) fn material(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "MATERIALS card");
+        let (id, id_span) = c.uint("material number")?;
+        c.ctx = format!("material {id}");
+        const KW: [&str; 5] = ["E", "NU", "G", "RHO", "DAMPING"];
+        let mut seen = Seen::default();
+        let (mut e, mut nu, mut g, mut rho, mut eta) = (None, None, None, None, 0.0);
+        while let Some(t) = c.peek() {
+            let Some((kw, ks)) = c.keyword(&KW) else {
+                return Err(c.unexpected(t, &expected_list(&KW)));
+            };
+            seen.add(kw, ks, &c.ctx)?;
+            match kw {
+                "E" => e = Some(c.number_in("E (Young's modulus)", "> 0 N/m²", |v| v > 0.0)?),
+                "NU" => {
+                    if seen.has("G") {
+                        return Err(conflict("G", "NU", &c.ctx, ks));
+                    }
+                    nu = Some(c.number_in("NU (Poisson's ratio)", "-1 < nu < 0.5", |v| {
+                        v > -1.0 && v < 0.5
+                    })?)
+                }
+                "G" => {
+                    if seen.has("NU") {
+                        return Err(conflict("NU", "G", &c.ctx, ks));
+                    }
+                    g = Some(c.number_in("G (shear modulus)", "> 0 N/m²", |v| v > 0.0)?)
+                }
+                "RHO" => rho = Some(c.number_in("RHO (density)", ">= 0 kg/m³", |v| v >= 0.0)?),
+                _ => {
+                    eta = c.number_in("DAMPING (stiffness-proportional)", ">= 0 s", |v| v >= 0.0)?
+                }
+            }
+        }
+        let missing = |what: &str| {
+            DeckError::new(
+                K::MissingKeyword {
+                    context: format!("material {id}"),
+                    expected: what.to_string(),
+                },
+                c.end_span(),
+            )
+        };
+        let e = e.ok_or_else(|| missing("E <Young's modulus>"))?;
+        let rho = rho.ok_or_else(|| missing("RHO <density>"))?;
+        let shear = match (nu, g) {
+            (_, Some(g)) => g,
+            (Some(nu), None) => e / (2.0 * (1.0 + nu)),
+            (None, None) => return Err(missing("NU <Poisson's ratio> or G <shear modulus>")),
+        };
+        if let Some(first) = self.materials.get(&MaterialId(id)).map(|m| m.span) {
+            self.duplicate("material", id, first, id_span);
+            return Ok(());
+        }
+        self.materials.insert(
+            MaterialId(id),
+            Material {
+                id: MaterialId(id),
+                young: e,
+                shear,
+                density: rho,
+                damping: eta,
+                span,
+            },
+        );
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- SECTIONS
+    pub(super) fn section(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "SECTIONS card");
+        let (id, id_span) = c.uint("section number")?;
+        c.ctx = format!("section {id}");
+        let rigid = c.keyword(&["RIGID"]).is_some();
+        let kws: &[&'static str] = if rigid {
+            &["A", "I2", "I3", "J"]
+        } else {
+            &["A", "I2", "I3", "J", "K"]
+        };
+        let mut seen = Seen::default();
+        let (mut a, mut i2, mut i3, mut j, mut k) = (None, None, None, None, 5.0 / 6.0);
+        while let Some(t) = c.peek() {
+            let Some((kw, ks)) = c.keyword(kws) else {
+                return Err(c.unexpected(t, &expected_list(kws)));
+            };
+            seen.add(kw, ks, &c.ctx)?;
+            let (range, ok): (&str, fn(f64) -> bool) = match (kw, rigid) {
+                ("A", _) => ("> 0 m²", |v| v > 0.0),
+                ("K", _) => ("0 < k <= 1", |v| v > 0.0 && v <= 1.0),
+                (_, true) => (">= 0 m⁴", |v| v >= 0.0),
+                _ => ("> 0 m⁴", |v| v > 0.0),
+            };
+            let v = c.number_in(kw, range, ok)?;
+            match kw {
+                "A" => a = Some(v),
+                "I2" => i2 = Some(v),
+                "I3" => i3 = Some(v),
+                "J" => j = Some(v),
+                _ => k = v,
+            }
+        }
+        let missing = |what: &str| {
+            DeckError::new(
+                K::MissingKeyword {
+                    context: format!("section {id}"),
+                    expected: what.to_string(),
+                },
+                c.end_span(),
+            )
+        };
+        let a = a.ok_or_else(|| missing("A <area>"))?;
+        let (i2, i3, j) = if rigid {
+            (i2.unwrap_or(0.0), i3.unwrap_or(0.0), j.unwrap_or(0.0))
+        } else {
+            (
+                i2.ok_or_else(|| missing("I2 <second moment>"))?,
+                i3.ok_or_else(|| missing("I3 <second moment>"))?,
+                j.ok_or_else(|| missing("J <torsion constant>"))?,
+            )
+        };
+        if let Some(first) = self.sections.get(&SectionId(id)).map(|s| s.span) {
+            self.duplicate("section", id, first, id_span);
+            return Ok(());
+        }
+        self.sections.insert(
+            SectionId(id),
+            Sec {
+                id: SectionId(id),
+                area: a,
+                i2,
+                i3,
+                torsion: j,
+                shear_factor: k,
+                rigid,
+                span,
+            },
+        );
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- FUNCTIONS
+    pub(super) fn function(&mut self, card: &Card<'_>) -> R<()> {
+        let span = card.span();
+        let mut c = Cursor::new(card, "FUNCTIONS card");
+        let (id, id_span) = c.uint("function number")?;
+        c.ctx = format!("function {id}");
+        let (kw, _) = c.expect_keyword(
+            &["TABLE", "CONSTANT", "HAVERSINE"],
+            "TABLE, CONSTANT or HAVERSINE",
+        )?;
+        let function = if kw == "CONSTANT" {
+            let (v, _, _) = c.number("the constant value")?;
+            c.finish()?;
+            Function::Constant(v)
+        } else if kw == "HAVERSINE" {
+            let (start, _, _) = c.number("the pulse's start time")?;
+            let duration = c.number_in("the pulse's duration", "> 0 s", |v| v > 0.0)?;
+            c.finish()?;
+            Function::Haversine { start, duration }
+        } else {
+            let mut vals = Vec::new();
+            while c.peek().is_some() {
+                vals.push(c.number("a table value (t or f)")?);
+            }
+            if vals.is_empty() || vals.len() % 2 == 1 {
+                return Err(DeckError::new(K::OddTable { count: vals.len() }, span));
+            }
+            for w in vals.chunks(2).collect::<Vec<_>>().windows(2) {
+                let (prev, cur) = (w[0][0], w[1][0]);
+                if cur.0 < prev.0 {
+                    return Err(DeckError::new(
+                        K::DecreasingTime {
+                            found: cur.2.to_string(),
+                            previous: prev.2.to_string(),
+                        },
+                        cur.1,
+                    ));
+                }
+            }
+            Function::Table(vals.chunks(2).map(|p| (p[0].0, p[1].0)).collect())
+        };
+        if let Some(first) = self.functions.get(&FunctionId(id)).map(|f| f.span) {
+            self.duplicate("function", id, first, id_span);
+            return Ok(());
+        }
+        self.functions.insert(
+            FunctionId(id),
+            FunctionDef {
+                id: FunctionId(id),
+                function,
+                span,
+            },
+        );
+        Ok(())
+    }
+}
