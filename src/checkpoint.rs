@@ -27,6 +27,8 @@ use std::path::{Path, PathBuf};
 
 /// Name of the checkpoint in an output directory.
 pub const FILE_NAME: &str = "checkpoint.bin";
+/// Name of the checkpoint being written (renamed to [`FILE_NAME`] once whole).
+pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// Version of the file format; a checkpoint of another version is refused.
 pub const FORMAT_VERSION: u32 = 1;
 const MAGIC: &[u8; 8] = b"MECANOCK";
@@ -154,7 +156,7 @@ fn failpoint(count: u64) -> bool {
 /// (module docs). `count` numbers the checkpoints of the process (for the test hook).
 pub fn write(dir: &Path, c: &Checkpoint, count: u64) -> io::Result<()> {
     let bytes = encode(c)?;
-    let tmp = dir.join(format!("{FILE_NAME}.tmp"));
+    let tmp = dir.join(TMP_NAME);
     let mut f = File::create(&tmp)?;
     if failpoint(count) {
         f.write_all(&bytes[..bytes.len() / 2])?;

@@ -32,6 +32,22 @@ impl CheckpointPlan {
     }
 }
 
+/// Test hook: `MECANO_FAILPOINT=signal:NAME:STEP` (NAME `INT`, `TERM` or `KILL`) sends the
+/// process that signal at the pause after step STEP, through the real handlers, so that
+/// tests stop a run at a known point rather than at a moment that depends on the
+/// machine's speed. (`checkpoint:N`: see [`crate::checkpoint`].) Unset: nothing.
+fn signal_failpoint() -> Option<(libc::c_int, u64)> {
+    let v = std::env::var("MECANO_FAILPOINT").ok()?;
+    let mut it = v.strip_prefix("signal:")?.split(':');
+    let sig = match it.next()? {
+        "INT" => libc::SIGINT,
+        "TERM" => libc::SIGTERM,
+        "KILL" => libc::SIGKILL,
+        _ => return None,
+    };
+    Some((sig, it.next()?.parse().ok()?))
+}
+
 /// Streams states to the writers; at each pause between steps writes a checkpoint when
 /// one is due, and stops the run when a signal asked.
 struct Controlled<'a> {
@@ -44,6 +60,8 @@ struct Controlled<'a> {
     last: Option<Instant>,
     /// Checkpoints written by this process.
     count: u64,
+    /// [`signal_failpoint`], read once.
+    failpoint: Option<(libc::c_int, u64)>,
 }
 
 impl Controlled<'_> {
@@ -92,6 +110,14 @@ impl Observer for Controlled<'_> {
     }
 
     fn pause(&mut self, integ: &Integrator, ctl: &LoopState) -> io::Result<Pause> {
+        if let Some((sig, step)) = self.failpoint
+            && integ.stats.steps == step
+        {
+            // SAFETY: kill(2) on our own pid has no memory-safety preconditions.
+            unsafe {
+                libc::kill(libc::getpid(), sig);
+            }
+        }
         let stop = self.interrupts.stopping();
         if let Some(plan) = self.plan {
             let due = stop
@@ -157,6 +183,7 @@ impl Session<'_> {
                 // A restart starts from a checkpoint: the next is due an interval later.
                 last: self.resume.map(|_| Instant::now()),
                 count: 0,
+                failpoint: signal_failpoint(),
             };
             solver::run_from(self.model, &mut self.integ, &mut obs, self.resume)
         };
@@ -200,6 +227,12 @@ impl Session<'_> {
         if let Some(v) = self.vtk.as_mut() {
             v.finish(integ, report.interrupted.is_some())
                 .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+        }
+        if report.failure.is_none() && report.interrupted.is_none() {
+            // A complete run is not resumed: its checkpoint is of no more use.
+            for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
+                let _ = std::fs::remove_file(dir.join(name));
+            }
         }
         Ok(report)
     }
