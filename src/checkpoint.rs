@@ -191,6 +191,62 @@ pub fn read(dir: &Path) -> Result<Checkpoint, CheckpointError> {
 mod tests {
     use super::*;
 
+    /// A checkpoint of a small model at its initial state.
+    fn sample() -> Vec<u8> {
+        let deck = "TITLE t\nMATERIALS\n  1 E 2.1e11 NU 0.3 RHO 7800\nSECTIONS\n  1 A 9e-4 I2 8.3e-8 I3 8.3e-8 J 4.15e-8\nNODES\n  1 0 0 0 FIX ALL\n  2 TO 3 LINE 0.5 0 0  1 0 0\nELEMENTS\n  1 TO 2 BEAM 1 2 MAT 1 SEC 1\nLOADS\n  GRAVITY 0 -9.81 0\nANALYSIS DYNAMIC STEP 1e-3 END 0.01\nOUTPUT NODES 3\n";
+        let model = crate::deck::parse_deck(deck, "t.dat").expect("deck parses");
+        let mut integ = crate::solver::prepare(&model).expect("builds");
+        integ.initialize().expect("initial accelerations");
+        let c = Checkpoint {
+            program: "test".into(),
+            deck: DeckIdentity {
+                path: "t.dat".into(),
+                absolute: None,
+                sha256: sha256_hex(deck.as_bytes()),
+            },
+            time: 0.0,
+            step: 0,
+            control: LoopState {
+                h: 1e-3,
+                good: 0,
+                retry: None,
+            },
+            integrator: integ.save_state().expect("simplicial"),
+            writer: WriterState::default(),
+            vtk: None,
+        };
+        encode(&c).unwrap()
+    }
+
+    #[test]
+    fn a_checkpoint_reads_back_to_the_same_bytes() {
+        let b = sample();
+        let c = decode(Path::new("c"), &b).unwrap();
+        // (Compared as bytes: the state holds NaNs, e.g. "no valid LU step".)
+        assert_eq!(encode(&c).unwrap(), b);
+    }
+
+    #[test]
+    fn torn_damaged_foreign_and_other_version_files_are_refused() {
+        let b = sample();
+        let why = |bytes: &[u8]| match decode(Path::new("c"), bytes) {
+            Err(CheckpointError::Invalid { why, .. }) => why,
+            other => panic!("accepted: {:?}", other.map(|c| c.step)),
+        };
+        assert!(why(&b[..b.len() - 1]).contains("torn"));
+        assert!(why(&b[..10]).contains("MECANOCK"));
+        let mut d = b.clone();
+        let k = d.len() - 7;
+        d[k] ^= 0x10;
+        assert!(why(&d).contains("checksum"));
+        let mut v = b.clone();
+        v[8] = 2;
+        assert!(why(&v).contains("version 2"));
+        let mut m = b;
+        m[0] = b'X';
+        assert!(why(&m).contains("MECANOCK"));
+    }
+
     #[test]
     fn sha256_of_a_known_text() {
         // FIPS 180-2, appendix B.1: SHA-256("abc").

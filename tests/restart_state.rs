@@ -145,3 +145,62 @@ fn adaptive_steps_restart_bit_for_bit() {
     }
     check_restarts("contact_bounce adaptive", &m, &[0.3, 0.5, 0.7]);
 }
+
+/// Sets the integrator's abort flag at the pause after step `at`, as a second Ctrl-C would.
+struct AbortAt {
+    at: u64,
+    flag: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl Observer for AbortAt {
+    fn state(&mut self, _snap: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn pause(&mut self, integ: &Integrator, _ctl: &LoopState) -> std::io::Result<Pause> {
+        if integ.stats.steps == self.at {
+            self.flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+        Ok(Pause::Continue)
+    }
+}
+
+#[test]
+fn an_abort_gives_up_the_step_under_way_and_is_not_a_failure() {
+    let m = deck("contact_bounce.dat");
+    let mut integ = solver::prepare(&m).unwrap();
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    integ.abort = Some(flag.clone());
+    let mut obs = AbortAt { at: 30, flag };
+    let rep = solver::run_prepared(&m, &mut integ, &mut obs).unwrap();
+    assert!(rep.failure.is_none(), "{:?}", rep.failure);
+    assert_eq!(rep.interrupted, Some(solver::Interruption::WithinStep));
+    assert_eq!(rep.stats.steps, 30, "the step after the abort is not taken");
+    assert_eq!(rep.stats.rejected_steps, 0, "nor counted as rejected");
+}
+
+/// Stops the run at the pause after step `at`.
+struct StopAt(u64);
+
+impl Observer for StopAt {
+    fn state(&mut self, _snap: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn pause(&mut self, integ: &Integrator, _ctl: &LoopState) -> std::io::Result<Pause> {
+        Ok(if integ.stats.steps == self.0 {
+            Pause::Stop
+        } else {
+            Pause::Continue
+        })
+    }
+}
+
+#[test]
+fn a_stop_at_a_pause_ends_at_that_step() {
+    let m = deck("contact_bounce.dat");
+    let rep = solver::run(&m, &mut StopAt(30)).unwrap();
+    assert!(rep.failure.is_none());
+    assert_eq!(rep.interrupted, Some(solver::Interruption::AtStep));
+    assert_eq!(rep.stats.steps, 30);
+}

@@ -101,7 +101,7 @@ pub struct Writer {
 /// What a [`Writer`] needs to go on after a restart: the length of each file at the
 /// checkpoint (what follows was written later, and is cut) and the energy balance's
 /// accumulators.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WriterState {
     /// (file name, length in bytes) of each history file, in the writer's order.
     pub files: Vec<(String, u64)>,

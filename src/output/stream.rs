@@ -55,7 +55,11 @@ impl Stream {
     /// follows them was written after the checkpoint, and is cut). The file must be at
     /// least `len` bytes long and begin with the header.
     pub(crate) fn reopen(path: &Path, header: &str, len: u64) -> io::Result<Self> {
-        let mut file = OpenOptions::new().read(true).write(true).open(path)?;
+        let mut file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
         let actual = file.metadata()?.len();
         if actual < len {
             return Err(io::Error::new(
