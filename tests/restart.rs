@@ -175,10 +175,10 @@ fn sigint_ends_at_a_step_with_whole_rows_and_resume_gives_identical_files() {
     assert_eq!(s["stop"]["reason"], "interrupted");
     assert_eq!(s["stop"]["at_step_end"], true);
     assert_eq!(s["signal"], "SIGINT");
-    // The signal is handled on another thread: the run ends at the first pause after it
-    // saw the flag, a few steps later at most.
+    // The failpoint waits for the handler's thread to see the signal: the run ends at
+    // that very pause.
     let step = s["stop"]["step"].as_u64().unwrap();
-    assert!((2500..2600).contains(&step), "stopped at step {step}");
+    assert_eq!(step, 2500);
     assert_eq!(s["time_reached"], s["stop"]["time"]);
     // The checkpoint is of that very step (the periodic one, 60 s, never came).
     let o = resume(&d);
@@ -198,16 +198,22 @@ fn sigterm_during_the_impact_then_again_in_the_restart_then_complete() {
     let (d, o) = stopped_run("sigterm", "signal:TERM:5400", "60");
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     assert_eq!(summary(&d)["signal"], "SIGTERM");
+    assert_eq!(summary(&d)["stop"]["step"], 5400);
     let o = run(
         &["resume", d.to_str().unwrap(), "-q"],
         Some("signal:TERM:5500"),
     );
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     assert_whole_rows(&d);
+    assert_eq!(summary(&d)["stop"]["step"], 5500);
     let o = resume(&d);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert_same_as_reference(&d);
-    assert_eq!(summary(&d)["resumes"].as_array().unwrap().len(), 2);
+    let r = summary(&d)["resumes"].clone();
+    assert_eq!(r.as_array().unwrap().len(), 2);
+    assert_eq!(r[0]["from_checkpoint"]["step"], 5400);
+    assert_eq!(r[1]["from_checkpoint"]["step"], 5500);
+    assert_eq!(r[1]["stopped"]["reason"], "interrupted");
 }
 
 #[test]
@@ -263,6 +269,7 @@ fn frozen_run(name: &str) -> (PathBuf, Child) {
             d.to_str().unwrap(),
         ])
         .env_remove("MECANO_FAILPOINT")
+        .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
     let pid = child.id() as libc::pid_t;

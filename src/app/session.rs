@@ -33,9 +33,9 @@ impl CheckpointPlan {
 }
 
 /// Test hook: `MECANO_FAILPOINT=signal:NAME:STEP` (NAME `INT`, `TERM` or `KILL`) sends the
-/// process that signal at the pause after step STEP, through the real handlers, so that
-/// tests stop a run at a known point rather than at a moment that depends on the
-/// machine's speed. (`checkpoint:N`: see [`crate::checkpoint`].) Unset: nothing.
+/// process that signal at the pause after step STEP, through the real handlers (and waits
+/// until they have seen it), so that tests stop a run at a known step rather than at a
+/// moment that depends on the machine's speed. (`checkpoint:N`: see [`crate::checkpoint`].) Unset: nothing.
 fn signal_failpoint() -> Option<(libc::c_int, u64)> {
     let v = std::env::var("MECANO_FAILPOINT").ok()?;
     let mut it = v.strip_prefix("signal:")?.split(':');
@@ -116,6 +116,12 @@ impl Observer for Controlled<'_> {
             // SAFETY: kill(2) on our own pid has no memory-safety preconditions.
             unsafe {
                 libc::kill(libc::getpid(), sig);
+            }
+            // The handler's thread sets the flag soon, but on a loaded machine maybe some
+            // steps later: wait for it, so that the stop is at this very step.
+            let t0 = Instant::now();
+            while !self.interrupts.stopping() && t0.elapsed() < Duration::from_secs(10) {
+                std::thread::sleep(Duration::from_micros(100));
             }
         }
         let stop = self.interrupts.stopping();
