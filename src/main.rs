@@ -23,7 +23,12 @@ use std::process::ExitCode;
     about,
     long_about = None,
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    after_help = "Exit codes: 0 the run completed; 1 the run failed (diagnosis on standard error, \
+histories kept, summary.json \"complete\": false); 2 bad input (deck errors, nothing written); \
+130 interrupted by Ctrl-C (SIGINT) or SIGTERM: the run ends at the end of the step under way \
+with whole rows and a checkpoint (a second signal ends it at once), and \
+`mecano-rs resume OUTDIR` goes on."
 )]
 struct Cli {
     /// A subcommand; without one, run the deck.
@@ -59,9 +64,17 @@ enum Command {
     Study(mecano::study::StudyArgs),
     /// Go on from the last checkpoint of a stopped run (Ctrl-C, SIGTERM, SIGKILL, a crash),
     /// appending to its files: they come out as those of a run never stopped.
+    #[command(
+        after_help = "Exit codes: as a run's (0 done, 1 failed, 130 interrupted again); 2 when the \
+restart is refused: no valid checkpoint, a complete run, or a deck whose text differs from the run's."
+    )]
     Resume(mecano::app::ResumeArgs),
     /// Compare the histories of two output directories (largest differences per node,
     /// column and time window); with --tol, exit 1 when a difference exceeds it.
+    #[command(
+        after_help = "Exit codes: 0 every difference judged is within its tolerance (or none is judged); \
+1 one exceeds it; 2 bad input (a missing directory, file, node, element or column)."
+    )]
     Compare(mecano::compare::CompareArgs),
 }
 
