@@ -154,6 +154,13 @@ fn start_session(
     let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
     let io_err = |e: std::io::Error| (EXIT_FAILED, format!("{}: {e}", dir.display()));
     let writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(io_err)?;
+    // A checkpoint of an earlier run in this directory belongs to files just replaced.
+    for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
+        match std::fs::remove_file(dir.join(name)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_err(e)),
+            _ => {}
+        }
+    }
     let vtk = if model.output.vtk {
         Some(VtkWriter::create(dir, model, &integ.sys).map_err(io_err)?)
     } else {

@@ -398,7 +398,11 @@ pub trait Element: Send + Sync {
         false
     }
 
-    /// Its history variables, for a checkpoint (default: none).
+    /// Its history variables, for a checkpoint (default: none). **An element that keeps
+    /// anything from one evaluation or step to the next** (what [`Element::commit`]
+    /// updates, interior-mutable attempt memory) must return all of it here and take it
+    /// back in [`Element::restore_state`]: a restart is bit for bit only if it does
+    /// (`tests/restart_state.rs` checks the elements with a history).
     fn save_state(&self) -> ElementState {
         ElementState::Stateless
     }
