@@ -383,3 +383,68 @@ fn resume_refuses_an_edited_deck_another_deck_a_complete_run_and_a_missing_check
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("checksum"), "{}", text(&o));
 }
+
+/// All files under `dir` (relative path → bytes), `summary.json` left out.
+fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().unwrap() != "summary.json" {
+                let rel = p.strip_prefix(dir).unwrap().display().to_string();
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_paraview_series_is_resumed_too() {
+    // The deck writing a VTK frame every 100 steps: after a SIGKILL at step 3000 (frames
+    // written after the last checkpoint are written again) the series is the same,
+    // frame files and model.pvd, byte for byte.
+    let base = tmp("vtk");
+    let source = std::fs::read_to_string(DECK)
+        .unwrap()
+        .replace("EVERY 10", "EVERY 100 VTK");
+    assert!(source.contains("EVERY 100 VTK"));
+    let deck = base.join("vtk.dat");
+    std::fs::write(&deck, source).unwrap();
+    let (a, b) = (base.join("a"), base.join("b"));
+    let o = run(
+        &[
+            deck.to_str().unwrap(),
+            "-q",
+            "--checkpoint",
+            "0",
+            "-o",
+            a.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = run(
+        &[
+            deck.to_str().unwrap(),
+            "-q",
+            "--checkpoint",
+            "0.01",
+            "-o",
+            b.to_str().unwrap(),
+        ],
+        Some("signal:KILL:3000"),
+    );
+    assert_eq!(o.status.code(), None, "{}", text(&o));
+    let o = resume(&b);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let (ta, tb) = (tree(&a), tree(&b));
+    assert!(ta.keys().any(|k| k.ends_with(".vtu")) && ta.contains_key("model.pvd"));
+    assert_eq!(ta.keys().collect::<Vec<_>>(), tb.keys().collect::<Vec<_>>());
+    for (k, v) in &ta {
+        assert!(tb[k] == *v, "{k} differs");
+    }
+}
