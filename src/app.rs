@@ -1,14 +1,25 @@
 //! The command-line application behind the thin `main.rs`: check a deck, run it, report.
 //!
 //! Exit codes: 0 done, 1 the run failed (diagnosis printed, outputs kept and marked
-//! incomplete), 2 bad input (deck errors, unsupported elements; nothing written).
+//! incomplete), 2 bad input (deck errors, unsupported elements; nothing written), 130
+//! interrupted (SIGINT or SIGTERM: whole rows kept, a checkpoint to go on from with
+//! `mecano-rs resume`).
 
+mod resume;
+mod session;
+
+pub use resume::{ResumeArgs, resume};
+pub use session::CheckpointPlan;
+
+use crate::checkpoint::{self, DeckIdentity};
 use crate::deck;
+use crate::interrupt::Interrupts;
 use crate::model::Model;
 use crate::output::Writer;
-use crate::output::vtk::{Fanout, VtkWriter};
+use crate::output::vtk::VtkWriter;
 use crate::solver::{self, RunReport};
-use std::io::{IsTerminal, Write};
+use session::Session;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Exit code: the run completed.
@@ -17,14 +28,35 @@ pub const EXIT_OK: u8 = 0;
 pub const EXIT_FAILED: u8 = 1;
 /// Exit code: bad input (the deck has errors or uses unsupported elements).
 pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code: the run was interrupted (SIGINT or SIGTERM; 128 + 2, the shell's code of a
+/// process ended by SIGINT). Its files end with whole rows, and a checkpoint lets
+/// `mecano-rs resume` go on.
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Default wall time between two checkpoints, s.
+pub const DEFAULT_CHECKPOINT_SECONDS: f64 = 60.0;
 
 /// Options of a run.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct RunOptions {
     /// Output directory (default `out/<deck name>/`, or the deck's OUTPUT DIR).
     pub out_dir: Option<PathBuf>,
     /// No progress bar, no summary on standard output.
     pub quiet: bool,
+    /// Wall time between two checkpoints, s (0: only at an interruption;
+    /// [`DEFAULT_CHECKPOINT_SECONDS`] by default).
+    pub checkpoint: f64,
+}
+
+impl RunOptions {
+    /// Options of a quiet run into `dir` with checkpoints every `checkpoint` seconds.
+    pub fn new(out_dir: Option<PathBuf>, quiet: bool, checkpoint: f64) -> Self {
+        RunOptions {
+            out_dir,
+            quiet,
+            checkpoint,
+        }
+    }
 }
 
 /// Parses a deck, printing diagnostics on error.
@@ -33,6 +65,29 @@ pub fn load(path: &Path) -> Result<Model, u8> {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })
+}
+
+/// Parses a deck read once, and names it: its path and the SHA-256 of the very text
+/// parsed (what a checkpoint is checked against).
+pub fn load_identified(path: &Path) -> Result<(Model, DeckIdentity), u8> {
+    let text = match std::fs::read(path).map(String::from_utf8) {
+        Ok(Ok(t)) => t,
+        // Unreadable or not UTF-8: the loader says so, with its diagnostics.
+        _ => return Err(load(path).err().unwrap_or(EXIT_BAD_INPUT)),
+    };
+    let name = path.display().to_string();
+    let model = deck::parse_deck(&text, &name).map_err(|errs| {
+        eprintln!("{:?}", miette::Report::new(errs));
+        EXIT_BAD_INPUT
+    })?;
+    let id = DeckIdentity {
+        path: name,
+        absolute: std::fs::canonicalize(path)
+            .ok()
+            .map(|p| p.display().to_string()),
+        sha256: checkpoint::sha256_hex(text.as_bytes()),
+    };
+    Ok((model, id))
 }
 
 /// `mecano-rs --check DECK`: parse, validate, build the system, print the summary.
@@ -75,87 +130,137 @@ pub fn default_out_dir(path: &Path, model: &Model) -> PathBuf {
     PathBuf::from("out").join(stem)
 }
 
-/// Runs a parsed model, writing into `dir`. Returns the report (with a failure if the run
-/// stopped early) or an exit code for errors before the run.
+/// Runs a parsed model, writing into `dir` (no checkpoints, no signal handling: the
+/// library's entry point). Returns the report (with a failure if the run stopped early)
+/// or an exit code and message for errors before the run.
 pub fn run_model(
     model: &Model,
     deck_name: &str,
     dir: &Path,
     quiet: bool,
 ) -> Result<RunReport, (u8, String)> {
-    let mut integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
-    let mut writer = Writer::create(dir, deck_name, model, &integ.sys)
-        .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
-    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
-        let pb = indicatif::ProgressBar::new(1000);
-        pb.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {msg} [{elapsed} elapsed, ~{eta} left]",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        pb
-    });
-    if let Some(pb) = bar.clone() {
-        writer.progress = Some(Box::new(move |t, end, st| {
-            pb.set_position(((t / end) * 1000.0) as u64);
-            pb.set_message(format!(
-                "t = {t:.4} s, {} steps, {} Newton iterations",
-                st.steps, st.newton_iterations
-            ));
-        }));
+    start_session(model, deck_name, dir, quiet, None, Interrupts::none())
+}
+
+/// Prepares the integrator and the writers of a fresh run, and executes it.
+fn start_session(
+    model: &Model,
+    deck_name: &str,
+    dir: &Path,
+    quiet: bool,
+    plan: Option<CheckpointPlan>,
+    interrupts: Interrupts,
+) -> Result<RunReport, (u8, String)> {
+    let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
+    let io_err = |e: std::io::Error| (EXIT_FAILED, format!("{}: {e}", dir.display()));
+    let writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(io_err)?;
+    // A checkpoint of an earlier run in this directory belongs to files just replaced.
+    for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
+        match std::fs::remove_file(dir.join(name)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_err(e)),
+            _ => {}
+        }
     }
-    let mut vtk = if model.output.vtk {
-        Some(
-            VtkWriter::create(dir, model, &integ.sys)
-                .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?,
-        )
+    let vtk = if model.output.vtk {
+        Some(VtkWriter::create(dir, model, &integ.sys).map_err(io_err)?)
     } else {
         None
     };
-    let result = match vtk.as_mut() {
-        Some(v) => solver::run_prepared(model, &mut integ, &mut Fanout(vec![&mut writer, v])),
-        None => solver::run_prepared(model, &mut integ, &mut writer),
-    };
-    if let Some(pb) = bar {
-        pb.finish_and_clear();
+    Session {
+        model,
+        dir,
+        quiet,
+        integ,
+        writer,
+        vtk,
+        plan,
+        interrupts,
+        resume: None,
     }
-    let mut report = match result {
-        Ok(r) => r,
-        Err(solver::RunError::Output(e)) => {
-            // The writer refused a row (non-finite value) or the disk failed: the run
-            // stops here, its files marked incomplete.
-            RunReport {
-                stats: integ.stats,
-                time: integ.t,
-                failure: Some(solver::Failure {
-                    time: integ.t,
-                    step: 0.0,
-                    reason: solver::FailureReason::NotFinite,
-                    residual_history: vec![],
-                    worst: format!("output: {e}"),
-                    worst_value: 0.0,
-                    reference_force: 0.0,
-                    diagnoses: Box::default(),
-                }),
-            }
-        }
-        Err(e) => return Err((EXIT_BAD_INPUT, e.to_string())),
+    .execute()
+}
+
+/// Prints the outcome of a run (or restart) of `what` and returns its exit code.
+fn report_outcome(what: &str, dir: &Path, quiet: bool, report: &RunReport) -> u8 {
+    let st = &report.stats;
+    let per = if st.steps > 0 {
+        st.newton_iterations as f64 / st.steps as f64
+    } else {
+        0.0
     };
-    report.stats = integ.stats;
-    writer
-        .finish(&integ, &report)
-        .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
-    if let Some(v) = vtk.as_mut() {
-        v.finish(&integ)
-            .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+    if let Some(f) = &report.failure {
+        eprintln!("error: {what}: the run stopped.\n{f}");
+        eprintln!(
+            "  histories up to t = {:.6e} s are kept in {} and marked incomplete (summary.json: \"complete\": false)",
+            report.time,
+            dir.display()
+        );
+        return EXIT_FAILED;
     }
-    Ok(report)
+    if let Some(how) = report.interrupted {
+        let from = match how {
+            solver::Interruption::AtStep => format!(
+                "a checkpoint of this state (t = {:.6e} s, step {}) is in {}",
+                report.time,
+                st.steps,
+                dir.join(checkpoint::FILE_NAME).display()
+            ),
+            solver::Interruption::WithinStep => format!(
+                "stopped within a step; the last checkpoint in {} is where a restart goes on",
+                dir.display()
+            ),
+        };
+        eprintln!(
+            "{what}: interrupted at t = {:.6e} s after {} steps; histories kept in {} (whole rows, summary.json: \"complete\": false);\n  {from}; go on with: mecano-rs resume {}",
+            report.time,
+            st.steps,
+            dir.display(),
+            dir.display()
+        );
+        return EXIT_INTERRUPTED;
+    }
+    if !quiet {
+        let _ = writeln!(
+            std::io::stdout(),
+            "{what}: done, t = {:.6} s, {} steps ({} rejected), {:.2} Newton iterations/step, {:.3} s CPU; output in {}",
+            report.time,
+            st.steps,
+            st.rejected_steps,
+            per,
+            st.cpu_seconds,
+            dir.display()
+        );
+    }
+    EXIT_OK
+}
+
+/// Installs the SIGINT/SIGTERM handlers (a failure to do so only costs clean stops).
+fn interrupts() -> Interrupts {
+    Interrupts::install().unwrap_or_else(|e| {
+        eprintln!("warning: cannot handle SIGINT/SIGTERM ({e}): a stop will not be clean");
+        Interrupts::none()
+    })
+}
+
+/// The `--checkpoint SECONDS` value, checked.
+fn checkpoint_seconds(s: f64) -> Result<f64, u8> {
+    if s.is_finite() && s >= 0.0 {
+        Ok(s)
+    } else {
+        eprintln!(
+            "error: --checkpoint takes a number of seconds >= 0 (0: only at an interruption), not {s}"
+        );
+        Err(EXIT_BAD_INPUT)
+    }
 }
 
 /// `mecano-rs DECK`: parse, run, write; returns the exit code.
 pub fn run(path: &Path, opts: &RunOptions) -> u8 {
-    let model = match load(path) {
+    let every = match checkpoint_seconds(opts.checkpoint) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let (model, id) = match load_identified(path) {
         Ok(m) => m,
         Err(code) => return code,
     };
@@ -163,44 +268,12 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         .out_dir
         .clone()
         .unwrap_or_else(|| default_out_dir(path, &model));
-    match run_model(&model, &path.display().to_string(), &dir, opts.quiet) {
-        Ok(report) => {
-            let st = &report.stats;
-            let per = if st.steps > 0 {
-                st.newton_iterations as f64 / st.steps as f64
-            } else {
-                0.0
-            };
-            match &report.failure {
-                None => {
-                    if !opts.quiet {
-                        let _ = writeln!(
-                            std::io::stdout(),
-                            "{}: done, t = {:.6} s, {} steps ({} rejected), {:.2} Newton iterations/step, {:.3} s CPU; output in {}",
-                            path.display(),
-                            report.time,
-                            st.steps,
-                            st.rejected_steps,
-                            per,
-                            st.cpu_seconds,
-                            dir.display()
-                        );
-                    }
-                    EXIT_OK
-                }
-                Some(f) => {
-                    eprintln!("error: {}: the run stopped.\n{f}", path.display());
-                    eprintln!(
-                        "  histories up to t = {:.6e} s are kept in {} and marked incomplete (summary.json: \"complete\": false)",
-                        report.time,
-                        dir.display()
-                    );
-                    EXIT_FAILED
-                }
-            }
-        }
+    let what = path.display().to_string();
+    let plan = CheckpointPlan::new(every, id);
+    match start_session(&model, &what, &dir, opts.quiet, Some(plan), interrupts()) {
+        Ok(report) => report_outcome(&what, &dir, opts.quiet, &report),
         Err((code, msg)) => {
-            eprintln!("error: {}: {msg}", path.display());
+            eprintln!("error: {what}: {msg}");
             code
         }
     }

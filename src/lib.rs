@@ -8,9 +8,12 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod app;
+pub mod checkpoint;
+pub mod compare;
 pub mod deck;
 pub mod dual;
 pub mod elements;
+pub mod interrupt;
 pub mod model;
 pub mod output;
 pub mod plot;

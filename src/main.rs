@@ -6,11 +6,16 @@ use std::process::ExitCode;
 
 /// mecano-rs — flexible multibody dynamics from a keyword input deck.
 ///
-/// `mecano-rs DECK` runs a deck; `mecano-rs plot …` draws figures from a run's output;
-/// `mecano-rs study DECK` measures what accuracy costs in time.
+/// `mecano-rs DECK` runs a deck; `mecano-rs resume OUTDIR` goes on after a stop;
+/// `mecano-rs compare RUN REF` compares the histories of two runs; `mecano-rs plot …`
+/// draws figures from a run's output; `mecano-rs study DECK` measures what accuracy costs
+/// in time.
 ///
 /// Exit codes: 0 the run completed; 1 the run failed (diagnosis on standard error,
-/// histories kept and marked incomplete); 2 bad input (deck errors, nothing written).
+/// histories kept and marked incomplete); 2 bad input (deck errors, nothing written);
+/// 130 interrupted by SIGINT (Ctrl-C) or SIGTERM: the run ends at the end of the step
+/// under way with whole rows and a checkpoint (a second signal ends it at once), and
+/// `mecano-rs resume OUTDIR` goes on.
 #[derive(Parser, Debug)]
 #[command(
     name = "mecano-rs",
@@ -18,7 +23,12 @@ use std::process::ExitCode;
     about,
     long_about = None,
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    after_help = "Exit codes: 0 the run completed; 1 the run failed (diagnosis on standard error, \
+histories kept, summary.json \"complete\": false); 2 bad input (deck errors, nothing written); \
+130 interrupted by Ctrl-C (SIGINT) or SIGTERM: the run ends at the end of the step under way \
+with whole rows and a checkpoint (a second signal ends it at once), and \
+`mecano-rs resume OUTDIR` goes on."
 )]
 struct Cli {
     /// A subcommand; without one, run the deck.
@@ -37,6 +47,10 @@ struct Cli {
     /// No progress bar and no closing summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Wall time between two checkpoints of the run's whole state (in the output
+    /// directory, checkpoint.bin), seconds; 0: only at an interruption.
+    #[arg(long, value_name = "SECONDS", default_value_t = mecano::app::DEFAULT_CHECKPOINT_SECONDS)]
+    checkpoint: f64,
 }
 
 /// Subcommands: one variant each, the logic in the library.
@@ -48,6 +62,20 @@ enum Command {
     /// report CPU time, steps, Newton iterations and errors per time window, draw error
     /// against CPU time.
     Study(mecano::study::StudyArgs),
+    /// Go on from the last checkpoint of a stopped run (Ctrl-C, SIGTERM, SIGKILL, a crash),
+    /// appending to its files: they come out as those of a run never stopped.
+    #[command(
+        after_help = "Exit codes: as a run's (0 done, 1 failed, 130 interrupted again); 2 when the \
+restart is refused: no valid checkpoint, a complete run, or a deck whose text differs from the run's."
+    )]
+    Resume(mecano::app::ResumeArgs),
+    /// Compare the histories of two output directories (largest differences per node,
+    /// column and time window); with --tol, exit 1 when a difference exceeds it.
+    #[command(
+        after_help = "Exit codes: 0 every difference judged is within its tolerance (or none is judged); \
+1 one exceeds it; 2 bad input (a missing directory, file, node, element or column)."
+    )]
+    Compare(mecano::compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
@@ -55,13 +83,12 @@ fn main() -> ExitCode {
     let code = match (&cli.command, &cli.deck) {
         (Some(Command::Plot(args)), _) => mecano::plot::run(args),
         (Some(Command::Study(args)), _) => mecano::study::run(args),
+        (Some(Command::Resume(args)), _) => mecano::app::resume(args),
+        (Some(Command::Compare(args)), _) => mecano::compare::run(args),
         (None, Some(deck)) if cli.check => mecano::app::check(deck),
         (None, Some(deck)) => mecano::app::run(
             deck,
-            &mecano::app::RunOptions {
-                out_dir: cli.out,
-                quiet: cli.quiet,
-            },
+            &mecano::app::RunOptions::new(cli.out, cli.quiet, cli.checkpoint),
         ),
         // clap requires DECK when no subcommand is given.
         (None, None) => mecano::app::EXIT_BAD_INPUT,

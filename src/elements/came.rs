@@ -56,7 +56,9 @@
 //! check (exact for lines and circles, a bounding circle for closed splines).
 
 use super::profile::{Curve, Projection, c};
-use super::{Element, Energies, EvalContext, Local, NodeState, StepLimit};
+use super::{
+    Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, StepLimit,
+};
 use crate::model::{CameData, ElementId, Profile};
 use nalgebra::{Matrix3, RealField, SVector, Vector2, Vector3};
 use num_dual::{Derivative, DualSVec64};
@@ -145,6 +147,25 @@ pub struct Came {
     attempt: AtomicU64,
     flips: AtomicU32,
     last_flag: AtomicBool,
+}
+
+/// The history of a [`Came`] (committed contact state, counters, and the attempt memory
+/// of the active set), for checkpoints.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CameState {
+    active: bool,
+    touching: bool,
+    touch_tol: f64,
+    restart: bool,
+    impacts: u64,
+    max_penetration: f64,
+    dissipated: f64,
+    last_power: f64,
+    omega: f64,
+    omega_trial: u64,
+    attempt: u64,
+    flips: u32,
+    last_flag: bool,
 }
 
 type D12 = DualSVec64<12>;
@@ -582,6 +603,44 @@ impl Element for Came {
 
     fn restart(&self) -> bool {
         self.restart
+    }
+
+    fn save_state(&self) -> ElementState {
+        ElementState::Came(CameState {
+            active: self.active,
+            touching: self.touching,
+            touch_tol: self.touch_tol,
+            restart: self.restart,
+            impacts: self.impacts,
+            max_penetration: self.max_penetration,
+            dissipated: self.dissipated,
+            last_power: self.last_power,
+            omega: self.omega,
+            omega_trial: self.omega_trial.load(Ordering::Relaxed),
+            attempt: self.attempt.load(Ordering::Relaxed),
+            flips: self.flips.load(Ordering::Relaxed),
+            last_flag: self.last_flag.load(Ordering::Relaxed),
+        })
+    }
+
+    fn restore_state(&mut self, state: &ElementState) -> Result<(), StateMismatch> {
+        let ElementState::Came(s) = state else {
+            return Err(StateMismatch { element: self.id });
+        };
+        self.active = s.active;
+        self.touching = s.touching;
+        self.touch_tol = s.touch_tol;
+        self.restart = s.restart;
+        self.impacts = s.impacts;
+        self.max_penetration = s.max_penetration;
+        self.dissipated = s.dissipated;
+        self.last_power = s.last_power;
+        self.omega = s.omega;
+        self.omega_trial.store(s.omega_trial, Ordering::Relaxed);
+        self.attempt.store(s.attempt, Ordering::Relaxed);
+        self.flips.store(s.flips, Ordering::Relaxed);
+        self.last_flag.store(s.last_flag, Ordering::Relaxed);
+        Ok(())
     }
 
     fn output_header(&self) -> Vec<String> {

@@ -58,7 +58,7 @@
 //! warning once to standard error, and [`Joint::singularity`] returns the diagnosis (for the
 //! solver to append to a failure).
 
-use super::{BuildError, Element, EvalContext, Local, NodeState};
+use super::{BuildError, Element, ElementState, EvalContext, Local, NodeState, StateMismatch};
 use crate::dual::{Dual, Real};
 use crate::model::{self, ElementId, ElementKind, Model};
 use crate::rotation::{self, c, skew};
@@ -140,7 +140,7 @@ struct Pair {
 }
 
 /// History of a joint (angles counted across ±π, universal-joint singularity watch).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 struct History {
     angles: [f64; 2],
     singular_passages: u64,
@@ -148,6 +148,11 @@ struct History {
     min_abs_cos_bend: Option<f64>,
     in_singular: bool,
 }
+
+/// The history of a [`Joint`] (last angles, passages through a universal joint's
+/// singular configuration), for checkpoints.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct JointState(History);
 
 /// A joint element (any [`JointType`]).
 #[derive(Debug, Clone)]
@@ -623,6 +628,18 @@ impl Element for Joint {
                 }
             }
         }
+    }
+
+    fn save_state(&self) -> ElementState {
+        ElementState::Joint(JointState(self.hist.clone()))
+    }
+
+    fn restore_state(&mut self, state: &ElementState) -> Result<(), StateMismatch> {
+        let ElementState::Joint(JointState(h)) = state else {
+            return Err(StateMismatch { element: self.id });
+        };
+        self.hist = h.clone();
+        Ok(())
     }
 
     fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {

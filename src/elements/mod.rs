@@ -124,6 +124,27 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
     }
 }
 
+/// The history variables of an element (what [`Element::commit`] and the attempt
+/// memory of [`Element::evaluate`] carry from one step to the next), for checkpoints: an
+/// element restored from it evaluates bit for bit as the one it was taken from.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum ElementState {
+    /// An element without history (beams, masses): nothing to keep.
+    Stateless,
+    /// A cam/follower contact ([`came::Came`]).
+    Came(came::CameState),
+    /// A joint ([`joints::Joint`]).
+    Joint(joints::JointState),
+}
+
+/// A saved [`ElementState`] that does not belong to the element it is given to.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("element {element}: the saved state is of another kind of element")]
+pub struct StateMismatch {
+    /// The element.
+    pub element: ElementId,
+}
+
 /// Kinematic state of one node.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeState {
@@ -375,6 +396,24 @@ pub trait Element: Send + Sync {
     /// so that no step straddles the jump. Default: never.
     fn restart(&self) -> bool {
         false
+    }
+
+    /// Its history variables, for a checkpoint (default: none). **An element that keeps
+    /// anything from one evaluation or step to the next** (what [`Element::commit`]
+    /// updates, interior-mutable attempt memory) must return all of it here and take it
+    /// back in [`Element::restore_state`]: a restart is bit for bit only if it does
+    /// (`tests/restart_state.rs` checks the elements with a history).
+    fn save_state(&self) -> ElementState {
+        ElementState::Stateless
+    }
+
+    /// Restores what [`Element::save_state`] returned; a state of another kind of element
+    /// is refused.
+    fn restore_state(&mut self, state: &ElementState) -> Result<(), StateMismatch> {
+        match state {
+            ElementState::Stateless => Ok(()),
+            _ => Err(StateMismatch { element: self.id() }),
+        }
     }
 
     /// Event (impact) control of a converged trial step from `old` to `new` (step

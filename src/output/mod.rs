@@ -1,8 +1,8 @@
 //! Output writers: per-node and per-element CSV histories, the energy balance and
 //! `summary.json`.
 //!
-//! Rows are streamed (flushed as they are written), so a run that stops early keeps what
-//! it computed. `summary.json` is written at the start with `"complete": false` and
+//! Rows are streamed, and reach the files only whole ([`stream`]), so a run that stops
+//! early keeps what it computed, and every file ends with a complete row. `summary.json` is written at the start with `"complete": false` and
 //! rewritten at the end; only a run that reached its end time says `"complete": true`.
 //!
 //! **Invariant:** no NaN or infinity is ever written: a non-finite value makes the writer
@@ -19,70 +19,22 @@
 //! error. `summary.json` reports its largest positive value relative to
 //! `max(|E(0)|, W_ext, the largest of T, U over the run)`.
 
+mod stream;
 pub mod vtk;
 
 use crate::model::{Model, Selection};
 use crate::rotation;
-use crate::solver::{Failure, Observer, RunReport, Snapshot, Stats, System};
-use std::fs::{self, File};
+use crate::solver::{Failure, Interruption, Observer, RunReport, Snapshot, Stats, System};
+use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
+use stream::Stream;
 
 /// Header of every node history file.
 pub const NODE_HEADER: &str = "t,x,y,z,ux,uy,uz,rx,ry,rz,vx,vy,vz,wx,wy,wz,ax,ay,az";
 
 /// Header of `energy.csv`.
 pub const ENERGY_HEADER: &str = "t,kinetic,strain,gravity,total,external_work,damping_dissipation,numerical_dissipation,balance_residual";
-
-struct Stream {
-    w: csv::Writer<File>,
-    /// File name and header, for messages.
-    name: String,
-    header: String,
-    /// Shortest round-trip formatting of a number (Ryū: Adams, PLDI 2018), several
-    /// times faster than `{:e}` (Grisu with a Dragon4 fallback), which took 30 % of a
-    /// run that wrote every node and element at every step (`OUTPUT`'s default).
-    num: ryu::Buffer,
-}
-
-impl Stream {
-    fn create(path: &Path, header: &str) -> io::Result<Self> {
-        // Numbers and column names never need quotes: the writer need not scan for them.
-        let mut w = csv::WriterBuilder::new()
-            .has_headers(false)
-            .quote_style(csv::QuoteStyle::Never)
-            .from_path(path)?;
-        w.write_record(header.split(','))?;
-        Ok(Stream {
-            w,
-            name: path
-                .file_name()
-                .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
-            header: header.to_string(),
-            num: ryu::Buffer::new(),
-        })
-    }
-
-    fn row(&mut self, values: &[f64]) -> io::Result<()> {
-        if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
-            let col = self.header.split(',').nth(bad).unwrap_or("?");
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!(
-                    "refusing to write a non-finite value to {} (column {}, `{col}`, t = {})",
-                    self.name,
-                    bad + 1,
-                    values[0]
-                ),
-            ));
-        }
-        for v in values {
-            self.w.write_field(self.num.format_finite(*v))?;
-        }
-        self.w.write_record(std::iter::empty::<&[u8]>())?;
-        Ok(())
-    }
-}
 
 /// A progress callback: time reached, end time, counters.
 pub type ProgressFn = Box<dyn FnMut(f64, f64, &Stats)>;
@@ -141,6 +93,63 @@ pub struct Writer {
     row: Vec<f64>,
     /// Optional progress callback (e.g. a progress bar): time, end time, counters.
     pub progress: Option<ProgressFn>,
+    /// Entries added to `summary.json` by the application (e.g. the record of a run's
+    /// interruptions and restarts).
+    pub notes: serde_json::Map<String, serde_json::Value>,
+}
+
+/// What a [`Writer`] needs to go on after a restart: the length of each file at the
+/// checkpoint (what follows was written later, and is cut) and the energy balance's
+/// accumulators.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WriterState {
+    /// (file name, length in bytes) of each history file, in the writer's order.
+    pub files: Vec<(String, u64)>,
+    e0: Option<f64>,
+    energy_scale: f64,
+    max_balance: f64,
+    last_row: Option<u64>,
+}
+
+/// The files a model's OUTPUT asks for: (dense node, file, header), (dense element,
+/// file, header).
+type Plan = (Vec<(usize, PathBuf)>, Vec<(usize, PathBuf, String)>);
+
+fn plan(dir: &Path, model: &Model, sys: &System) -> Plan {
+    let node_idx: Vec<usize> = match &model.output.nodes {
+        Selection::All => (0..model.nodes.len()).collect(),
+        Selection::None => Vec::new(),
+        Selection::List(l) => l
+            .iter()
+            .filter_map(|id| model.nodes.get_index_of(id))
+            .collect(),
+    };
+    let nodes = node_idx
+        .into_iter()
+        .map(|i| (i, dir.join(format!("node_{}.csv", sys.node_ids[i].0))))
+        .collect();
+    let elem_idx: Vec<usize> = match &model.output.elements {
+        Selection::All => (0..model.elements.len()).collect(),
+        Selection::None => Vec::new(),
+        Selection::List(l) => l
+            .iter()
+            .filter_map(|id| model.elements.get_index_of(id))
+            .collect(),
+    };
+    let mut elements = Vec::new();
+    for e in elem_idx {
+        let el = &sys.elements[e];
+        let header = el.output_header();
+        if header.is_empty() {
+            continue;
+        }
+        elements.push((
+            e,
+            dir.join(format!("element_{}.csv", el.id().0)),
+            format!("t,{}", header.join(",")),
+        ));
+    }
+    (nodes, elements)
 }
 
 impl Writer {
@@ -148,48 +157,82 @@ impl Writer {
     /// `summary.json` that says `"complete": false` until [`Writer::finish`] says otherwise.
     pub fn create(dir: &Path, deck: &str, model: &Model, sys: &System) -> io::Result<Self> {
         fs::create_dir_all(dir)?;
-        let node_idx: Vec<usize> = match &model.output.nodes {
-            Selection::All => (0..model.nodes.len()).collect(),
-            Selection::None => Vec::new(),
-            Selection::List(l) => l
-                .iter()
-                .filter_map(|id| model.nodes.get_index_of(id))
-                .collect(),
-        };
+        let (node_files, elem_files) = plan(dir, model, sys);
         let mut nodes = Vec::new();
-        for i in node_idx {
-            let id = sys.node_ids[i].0;
-            nodes.push((
-                i,
-                Stream::create(&dir.join(format!("node_{id}.csv")), NODE_HEADER)?,
-            ));
+        for (i, path) in node_files {
+            nodes.push((i, Stream::create(&path, NODE_HEADER)?));
         }
-        let elem_idx: Vec<usize> = match &model.output.elements {
-            Selection::All => (0..model.elements.len()).collect(),
-            Selection::None => Vec::new(),
-            Selection::List(l) => l
-                .iter()
-                .filter_map(|id| model.elements.get_index_of(id))
-                .collect(),
-        };
         let mut elements = Vec::new();
-        for e in elem_idx {
-            let el = &sys.elements[e];
-            let header = el.output_header();
-            if header.is_empty() {
-                continue;
-            }
-            let head = format!("t,{}", header.join(","));
-            elements.push((
-                e,
-                Stream::create(&dir.join(format!("element_{}.csv", el.id().0)), &head)?,
+        for (e, path, head) in elem_files {
+            elements.push((e, Stream::create(&path, &head)?));
+        }
+        let energy = Stream::create(&dir.join("energy.csv"), ENERGY_HEADER)?;
+        let w = Self::with_streams(dir, deck, model, nodes, elements, energy);
+        w.write_summary(None, None)?;
+        Ok(w)
+    }
+
+    /// Reopens the files of a stopped run in `dir` to go on from a checkpoint: each is cut
+    /// back to the length `state` recorded, and the energy balance goes on from its
+    /// accumulators. The files must be those the model's OUTPUT asks for.
+    pub fn resume(
+        dir: &Path,
+        deck: &str,
+        model: &Model,
+        sys: &System,
+        state: &WriterState,
+    ) -> io::Result<Self> {
+        let (node_files, elem_files) = plan(dir, model, sys);
+        let mut names: Vec<(PathBuf, String)> = node_files
+            .iter()
+            .map(|(_, p)| (p.clone(), NODE_HEADER.to_string()))
+            .collect();
+        names.extend(elem_files.iter().map(|(_, p, h)| (p.clone(), h.clone())));
+        names.push((dir.join("energy.csv"), ENERGY_HEADER.to_string()));
+        let expected: Vec<String> = names.iter().map(|(p, _)| stream::file_name(p)).collect();
+        let saved: Vec<String> = state.files.iter().map(|(n, _)| n.clone()).collect();
+        if expected != saved {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "the checkpoint's files [{}] are not the deck's outputs [{}]",
+                    saved.join(", "),
+                    expected.join(", ")
+                ),
             ));
         }
+        let mut streams = Vec::with_capacity(names.len());
+        for ((path, header), (_, len)) in names.iter().zip(&state.files) {
+            streams.push(Stream::reopen(path, header, *len)?);
+        }
+        let energy = streams.pop().expect("energy.csv is always written");
+        let elements: Vec<(usize, Stream)> = elem_files
+            .iter()
+            .map(|(e, _, _)| *e)
+            .zip(streams.drain(node_files.len()..))
+            .collect();
+        let nodes: Vec<(usize, Stream)> = node_files.iter().map(|(i, _)| *i).zip(streams).collect();
+        let mut w = Self::with_streams(dir, deck, model, nodes, elements, energy);
+        w.e0 = state.e0;
+        w.energy_scale = state.energy_scale;
+        w.max_balance = state.max_balance;
+        w.last_row = state.last_row;
+        Ok(w)
+    }
+
+    fn with_streams(
+        dir: &Path,
+        deck: &str,
+        model: &Model,
+        nodes: Vec<(usize, Stream)>,
+        elements: Vec<(usize, Stream)>,
+        energy: Stream,
+    ) -> Self {
         let end = match model.analysis {
             crate::model::Analysis::Dynamic { end, .. } => end,
             crate::model::Analysis::Static { .. } => 1.0,
         };
-        let w = Writer {
+        Writer {
             dir: dir.to_path_buf(),
             deck: deck.to_string(),
             title: model.title.clone(),
@@ -198,16 +241,40 @@ impl Writer {
             sampling: Sampling::of(model),
             nodes,
             elements,
-            energy: Stream::create(&dir.join("energy.csv"), ENERGY_HEADER)?,
+            energy,
             e0: None,
             energy_scale: 0.0,
             max_balance: 0.0,
             last_row: None,
             row: Vec::new(),
             progress: None,
-        };
-        w.write_summary(None, None)?;
-        Ok(w)
+            notes: serde_json::Map::new(),
+        }
+    }
+
+    /// Writes every buffered row, waits until the files are on the disk, and returns the
+    /// state a restart from this point needs ([`WriterState`]). What the files hold is not
+    /// changed: only when it reaches the disk.
+    pub fn save_state(&mut self) -> io::Result<WriterState> {
+        let mut files = Vec::with_capacity(self.nodes.len() + self.elements.len() + 1);
+        for (_, s) in self.nodes.iter_mut().chain(self.elements.iter_mut()) {
+            s.sync()?;
+            files.push((s.name.clone(), s.len()));
+        }
+        self.energy.sync()?;
+        files.push((self.energy.name.clone(), self.energy.len()));
+        Ok(WriterState {
+            files,
+            e0: self.e0,
+            energy_scale: self.energy_scale,
+            max_balance: self.max_balance,
+            last_row: self.last_row,
+        })
+    }
+
+    /// Rewrites `summary.json` (e.g. after [`Writer::notes`] changed), still incomplete.
+    pub fn write_notes(&self) -> io::Result<()> {
+        self.write_summary(None, None)
     }
 
     /// The output directory.
@@ -269,11 +336,12 @@ impl Writer {
         Ok(())
     }
 
-    fn flush(&mut self) -> io::Result<()> {
+    /// Writes every buffered row to its file (rows are only ever written whole).
+    pub fn flush(&mut self) -> io::Result<()> {
         for (_, s) in self.nodes.iter_mut().chain(self.elements.iter_mut()) {
-            s.w.flush()?;
+            s.flush()?;
         }
-        self.energy.w.flush()
+        self.energy.flush()
     }
 
     fn write_summary(
@@ -281,7 +349,7 @@ impl Writer {
         report: Option<&RunReport>,
         extra: Option<serde_json::Value>,
     ) -> io::Result<()> {
-        let complete = report.is_some_and(|r| r.failure.is_none());
+        let complete = report.is_some_and(|r| r.failure.is_none() && r.interrupted.is_none());
         let mut v = serde_json::json!({
             "deck": self.deck,
             "title": self.title,
@@ -292,6 +360,18 @@ impl Writer {
         if let Some(r) = report {
             let st = &r.stats;
             v["time_reached"] = serde_json::json!(r.time);
+            v["stop"] = if let Some(how) = r.interrupted {
+                serde_json::json!({
+                    "reason": "interrupted",
+                    "time": r.time,
+                    "step": st.steps,
+                    "at_step_end": how == Interruption::AtStep,
+                })
+            } else if let Some(f) = &r.failure {
+                serde_json::json!({ "reason": "failed", "time": f.time, "step": st.steps })
+            } else {
+                serde_json::Value::Null
+            };
             v["stats"] = serde_json::to_value(st).unwrap_or_default();
             v["newton_iterations_per_step"] = serde_json::json!(if st.steps > 0 {
                 st.newton_iterations as f64 / st.steps as f64
@@ -307,20 +387,24 @@ impl Writer {
         if let Some(x) = extra {
             v["elements"] = x;
         }
+        for (k, x) in &self.notes {
+            v[k] = x.clone();
+        }
         let text = serde_json::to_string_pretty(&v).unwrap_or_else(|_| "{}".into());
         let tmp = self.dir.join("summary.json.tmp");
         fs::write(&tmp, text)?;
         fs::rename(tmp, self.dir.join("summary.json"))
     }
 
-    /// Writes the final state if it was skipped by `EVERY`, flushes, and rewrites
-    /// `summary.json` with the counters and the `complete` flag.
+    /// Writes the final state if it was skipped by `EVERY` (not for an interrupted run:
+    /// its files end where a restart goes on), flushes, and rewrites `summary.json` with
+    /// the counters and the `complete` flag.
     pub fn finish(
         &mut self,
         integ: &crate::solver::Integrator,
         report: &RunReport,
     ) -> io::Result<()> {
-        if self.last_row != Some(integ.stats.steps) {
+        if self.last_row != Some(integ.stats.steps) && report.interrupted.is_none() {
             self.write_state(&Snapshot {
                 integ,
                 step: integ.stats.steps,

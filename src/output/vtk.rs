@@ -27,6 +27,13 @@ pub const PVD_EVERY: usize = 50;
 /// Name of the collection file in the output directory.
 pub const PVD_NAME: &str = "model.pvd";
 
+/// What a [`VtkWriter`] needs to go on after a restart: the frames written so far.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct VtkState {
+    frames: Vec<(f64, String)>,
+    last_step: Option<u64>,
+}
+
 /// Streams the deformed model to a ParaView series.
 pub struct VtkWriter {
     dir: PathBuf,
@@ -40,7 +47,13 @@ pub struct VtkWriter {
 
 impl VtkWriter {
     /// Creates `dir/vtk/` and an empty `dir/model.pvd`.
-    pub fn create(dir: &Path, model: &Model, _sys: &System) -> io::Result<Self> {
+    pub fn create(dir: &Path, model: &Model, sys: &System) -> io::Result<Self> {
+        let w = Self::create_in(dir, model, sys)?;
+        w.write_pvd()?;
+        Ok(w)
+    }
+
+    fn create_in(dir: &Path, model: &Model, _sys: &System) -> io::Result<Self> {
         fs::create_dir_all(dir.join("vtk"))?;
         let mut cells = Vec::new();
         for el in model.elements.values() {
@@ -62,7 +75,6 @@ impl VtkWriter {
             frames: Vec::new(),
             last_step: None,
         };
-        w.write_pvd()?;
         Ok(w)
     }
 
@@ -173,9 +185,33 @@ impl VtkWriter {
         fs::rename(tmp, self.dir.join(PVD_NAME))
     }
 
-    /// Writes the final state if `EVERY` skipped it, and the complete `.pvd`.
-    pub fn finish(&mut self, integ: &crate::solver::Integrator) -> io::Result<()> {
-        if self.last_step != Some(integ.stats.steps) {
+    /// The state a restart needs: the frames written so far (the `.pvd` is rewritten
+    /// with them now). Frames written after it are written again by the restart.
+    pub fn save_state(&self) -> io::Result<VtkState> {
+        self.write_pvd()?;
+        Ok(VtkState {
+            frames: self.frames.clone(),
+            last_step: self.last_step,
+        })
+    }
+
+    /// Goes on from a [`VtkWriter::save_state`] in `dir` (the series is cut back to it).
+    pub fn resume(dir: &Path, model: &Model, sys: &System, state: &VtkState) -> io::Result<Self> {
+        let mut w = Self::create_in(dir, model, sys)?;
+        w.frames = state.frames.clone();
+        w.last_step = state.last_step;
+        w.write_pvd()?;
+        Ok(w)
+    }
+
+    /// Writes the final state if `EVERY` skipped it (not for an interrupted run, which a
+    /// restart goes on from), and the complete `.pvd`.
+    pub fn finish(
+        &mut self,
+        integ: &crate::solver::Integrator,
+        interrupted: bool,
+    ) -> io::Result<()> {
+        if self.last_step != Some(integ.stats.steps) && !interrupted {
             self.write_frame(&Snapshot {
                 integ,
                 step: integ.stats.steps,
@@ -211,5 +247,19 @@ impl Observer for Fanout<'_> {
         for o in &mut self.0 {
             o.progress(t, end, stats);
         }
+    }
+
+    fn pause(
+        &mut self,
+        integ: &crate::solver::Integrator,
+        ctl: &crate::solver::LoopState,
+    ) -> io::Result<crate::solver::Pause> {
+        let mut out = crate::solver::Pause::Continue;
+        for o in &mut self.0 {
+            if o.pause(integ, ctl)? == crate::solver::Pause::Stop {
+                out = crate::solver::Pause::Stop;
+            }
+        }
+        Ok(out)
     }
 }

@@ -115,15 +115,19 @@ pub struct Integrator {
     /// Steps no longer than this are never refused by [`crate::elements::Element::step_limit`] (the run's
     /// smallest step), so a refusal cannot repeat forever.
     pub event_floor: f64,
+    /// Set (from another thread, e.g. a signal handler's) to give up the step under way
+    /// at its next Newton iteration ([`FailureReason::Aborted`]); the state is then left
+    /// as a failed attempt leaves it. `None` = never.
+    pub abort: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Step size the numeric LU in `sys.matrix` was computed for (NaN = none valid): a later
     /// step of the same size starts from it (modified Newton).
-    lu_step: f64,
-    trial: Vec<NodeState>,
-    trial_pseudo: Vec<[Vector3<f64>; 2]>,
-    trial_lambda: Vec<f64>,
-    delta: Vec<f64>,
-    u: Vec<[Vector3<f64>; 2]>,
-    tmap: Vec<nalgebra::Matrix3<f64>>,
+    pub(super) lu_step: f64,
+    pub(super) trial: Vec<NodeState>,
+    pub(super) trial_pseudo: Vec<[Vector3<f64>; 2]>,
+    pub(super) trial_lambda: Vec<f64>,
+    pub(super) delta: Vec<f64>,
+    pub(super) u: Vec<[Vector3<f64>; 2]>,
+    pub(super) tmap: Vec<nalgebra::Matrix3<f64>>,
     /// Newton residual history of the step under way (kept between steps so that a
     /// successful step allocates nothing; handed to the [`Failure`] of a failed one).
     history: Vec<f64>,
@@ -173,6 +177,7 @@ impl Integrator {
             adaptive: None,
             error_next: f64::INFINITY,
             event_floor: 0.0,
+            abort: None,
             sys,
         }
     }
@@ -519,6 +524,11 @@ impl Integrator {
         // Whether the last solve used a matrix built at the iterate it started from.
         let mut fresh = false;
         for iter in 0..=self.newton.max_iterations {
+            if let Some(a) = &self.abort
+                && a.load(std::sync::atomic::Ordering::Relaxed)
+            {
+                return Err(self.failure(h, FailureReason::Aborted, history, fref));
+            }
             self.trial_from_u(h);
             if tangent {
                 self.update_tangent_maps();

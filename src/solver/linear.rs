@@ -24,6 +24,9 @@ use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factoriz
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
+mod state;
+pub use state::LuState;
+
 /// Errors of the linear solver.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
 pub enum LinearError {
@@ -33,6 +36,9 @@ pub enum LinearError {
     /// The numeric factorisation failed (singular matrix).
     #[error("the iteration matrix is singular (numeric LU failed: {0})")]
     Singular(String),
+    /// A saved state ([`LuState`]) does not fit this matrix.
+    #[error("the saved LU state does not fit: {0}")]
+    State(String),
 }
 
 /// Which sparse LU faer runs.

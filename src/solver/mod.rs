@@ -6,6 +6,7 @@
 
 pub mod integrator;
 pub mod linear;
+pub mod state;
 pub mod system;
 
 pub use integrator::{HhtParams, Integrator, StepInfo};
@@ -15,7 +16,7 @@ use crate::model::{Analysis, Model};
 use std::time::Instant;
 
 /// Counters of a run (written to `summary.json`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Stats {
     /// Accepted steps.
     pub steps: u64,
@@ -52,6 +53,9 @@ pub enum FailureReason {
     /// Newton converged but an element refused the step as too long (e.g. an impact
     /// resolved by too few steps): retry with this step, s.
     StepRefused(f64),
+    /// The run was asked to stop at once ([`Integrator::abort`], e.g. a second Ctrl-C):
+    /// not a failure of the step, which was given up.
+    Aborted,
 }
 
 /// The diagnosis of a failed run: where, when and how badly.
@@ -88,6 +92,7 @@ impl std::fmt::Display for Failure {
             FailureReason::StepRefused(h) => {
                 format!("an element refused the step (asks for h <= {h:.3e} s)")
             }
+            FailureReason::Aborted => "the run was aborted".to_string(),
         };
         writeln!(
             f,
@@ -128,6 +133,47 @@ pub trait Observer {
     fn state(&mut self, snap: &Snapshot) -> std::io::Result<()>;
     /// Progress: time reached and end time.
     fn progress(&mut self, _t: f64, _end: f64, _stats: &Stats) {}
+    /// A pause between two steps: after the initial state and after each accepted step,
+    /// once the step controller has chosen the next step. The state is complete here
+    /// ([`Integrator::save_state`] and `ctl`): a checkpoint taken now restarts bit for
+    /// bit. [`Pause::Stop`] ends the run here, as interrupted. An error stops the run.
+    fn pause(&mut self, _integ: &Integrator, _ctl: &LoopState) -> std::io::Result<Pause> {
+        Ok(Pause::Continue)
+    }
+}
+
+/// An observer's decision at a pause between two steps ([`Observer::pause`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pause {
+    /// Go on.
+    Continue,
+    /// End the run here (an interruption): the state is that of the last accepted step.
+    Stop,
+}
+
+/// The step controller's state between two steps (the rest of the run loop's state is
+/// the integrator's or derived from the model): the nominal step, the count of good
+/// steps since a cut, and the step an element asked for after refusing one.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LoopState {
+    /// Nominal next step, s.
+    pub h: f64,
+    /// Accepted steps since the step was last cut (fixed steps double back after 4).
+    pub good: u32,
+    /// The step an element asked for, tried once before `h`.
+    pub retry: Option<f64>,
+}
+
+/// How a run ended before its end time without failing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interruption {
+    /// Stopped at a pause between two steps ([`Pause::Stop`]): the state is that of the
+    /// last accepted step, and a checkpoint of it restarts the run.
+    AtStep,
+    /// Aborted within a step ([`Integrator::abort`]): the integrator's state is not that
+    /// of a step's end (the LU may have been refactored); only an earlier checkpoint
+    /// restarts the run.
+    WithinStep,
 }
 
 /// Result of a run.
@@ -139,6 +185,8 @@ pub struct RunReport {
     pub time: f64,
     /// The diagnosis if the run stopped before its end.
     pub failure: Option<Failure>,
+    /// Whether (and how) the run was interrupted before its end (not a failure).
+    pub interrupted: Option<Interruption>,
 }
 
 /// Errors that prevent a run from starting or continuing.
@@ -196,7 +244,25 @@ pub fn run_prepared(
     integ: &mut Integrator,
     obs: &mut dyn Observer,
 ) -> Result<RunReport, RunError> {
+    run_from(model, integ, obs, None)
+}
+
+/// Runs an already prepared integrator from its initial state (`resume = None`), or goes
+/// on from a restored state ([`Integrator::restore_state`]) with the step controller's
+/// state saved with it: the initial state is then neither recomputed nor observed, and
+/// the CPU seconds add to those of the restored counters.
+pub fn run_from(
+    model: &Model,
+    integ: &mut Integrator,
+    obs: &mut dyn Observer,
+    resume: Option<LoopState>,
+) -> Result<RunReport, RunError> {
     let start = Instant::now();
+    let cpu0 = if resume.is_some() {
+        integ.stats.cpu_seconds
+    } else {
+        0.0
+    };
     let (end, h0, hmin, hmax) = match &model.analysis {
         Analysis::Dynamic {
             step,
@@ -210,19 +276,22 @@ pub fn run_prepared(
             (1.0, h, h / 1024.0, h)
         }
     };
-    integ.stats.min_step = f64::INFINITY;
     if let Analysis::Dynamic { adaptive, .. } = &model.analysis {
         integ.adaptive = adaptive.clone();
     }
     let adaptive = integ.adaptive.is_some();
     integ.event_floor = hmin;
-    let mut failure = integ.initialize().err();
-    if failure.is_none() {
-        obs.state(&Snapshot {
-            integ,
-            step: 0,
-            h: 0.0,
-        })?;
+    let mut failure = None;
+    if resume.is_none() {
+        integ.stats.min_step = f64::INFINITY;
+        failure = integ.initialize().err();
+        if failure.is_none() {
+            obs.state(&Snapshot {
+                integ,
+                step: 0,
+                h: 0.0,
+            })?;
+        }
     }
     // Breakpoints of load functions: steps land on them rather than straddle a kink.
     let mut breaks: Vec<f64> = integ
@@ -235,13 +304,30 @@ pub fn run_prepared(
         .collect();
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();
-    let mut h = h0;
-    let mut good = 0u32;
+    let ctl = resume.unwrap_or(LoopState {
+        h: h0,
+        good: 0,
+        retry: None,
+    });
+    let mut h = ctl.h;
+    let mut good = ctl.good;
     let eps = 1e-9 * h0;
     // A step an element asked for after refusing one (an event's time): tried once, the
     // nominal step `h` stays as it was.
-    let mut retry: Option<f64> = None;
+    let mut retry: Option<f64> = ctl.retry;
+    // Pauses come after the initial state and after each accepted step (not after a
+    // refused attempt, nor at once after a restart: that state was the last pause's).
+    let mut pause_due = resume.is_none();
+    let mut interrupted = None;
     while failure.is_none() && integ.t < end - eps {
+        if pause_due {
+            pause_due = false;
+            let ctl = LoopState { h, good, retry };
+            if obs.pause(integ, &ctl)? == Pause::Stop {
+                interrupted = Some(Interruption::AtStep);
+                break;
+            }
+        }
         let t = integ.t;
         let mut h_try = retry
             .take()
@@ -287,8 +373,9 @@ pub fn run_prepared(
                 integ.stats.max_step = integ.stats.max_step.max(h_try);
                 let v = integ.constraint_violation();
                 integ.stats.max_constraint_violation = integ.stats.max_constraint_violation.max(v);
-                integ.stats.cpu_seconds = start.elapsed().as_secs_f64();
+                integ.stats.cpu_seconds = cpu0 + start.elapsed().as_secs_f64();
                 integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
+                pause_due = true;
                 obs.state(&Snapshot {
                     integ,
                     step: integ.stats.steps,
@@ -305,6 +392,13 @@ pub fn run_prepared(
                     h = (2.0 * h).min(h0);
                     good = 0;
                 }
+            }
+            Err(Failure {
+                reason: FailureReason::Aborted,
+                ..
+            }) => {
+                interrupted = Some(Interruption::WithinStep);
+                break;
             }
             Err(Failure {
                 reason: FailureReason::StepRefused(h_ok),
@@ -327,12 +421,13 @@ pub fn run_prepared(
     if integ.stats.min_step == f64::INFINITY {
         integ.stats.min_step = 0.0;
     }
-    integ.stats.cpu_seconds = start.elapsed().as_secs_f64();
+    integ.stats.cpu_seconds = cpu0 + start.elapsed().as_secs_f64();
     integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
     Ok(RunReport {
         stats: integ.stats,
         time: integ.t,
         failure,
+        interrupted,
     })
 }
 

@@ -1,0 +1,63 @@
+//! SIGINT and SIGTERM: the first ends a run at the end of the step under way, the second
+//! at once (within one Newton iteration).
+//!
+//! A thread of `signal-hook` receives the signals (no work in a signal handler) and sets
+//! two flags the run reads: [`Interrupts::stop`], read between steps, where the run writes
+//! a checkpoint and ends; [`Interrupts::abort`], read at each Newton iteration, where the
+//! step is given up (no checkpoint then: the last one stays the restart point). Either
+//! way the histories keep only whole rows and `summary.json` says why the run stopped.
+
+use signal_hook::consts::{SIGINT, SIGTERM};
+use signal_hook::iterator::Signals;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
+
+/// The flags the signals set.
+#[derive(Debug, Clone, Default)]
+pub struct Interrupts {
+    /// Set by the first signal: end at the end of the step under way.
+    pub stop: Arc<AtomicBool>,
+    /// Set by the second: end at once.
+    pub abort: Arc<AtomicBool>,
+    /// The last signal received (0 = none).
+    signal: Arc<AtomicI32>,
+}
+
+impl Interrupts {
+    /// Flags no signal sets (library use, tests).
+    pub fn none() -> Self {
+        Self::default()
+    }
+
+    /// Installs the handlers of SIGINT and SIGTERM for the rest of the process.
+    pub fn install() -> std::io::Result<Self> {
+        let me = Self::default();
+        let mut signals = Signals::new([SIGINT, SIGTERM])?;
+        let (stop, abort, signal) = (me.stop.clone(), me.abort.clone(), me.signal.clone());
+        std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || {
+                for sig in signals.forever() {
+                    signal.store(sig, Ordering::SeqCst);
+                    if stop.swap(true, Ordering::SeqCst) {
+                        abort.store(true, Ordering::SeqCst);
+                    }
+                }
+            })?;
+        Ok(me)
+    }
+
+    /// Whether a stop was asked for.
+    pub fn stopping(&self) -> bool {
+        self.stop.load(Ordering::SeqCst)
+    }
+
+    /// The name of the last signal received (`SIGINT`, `SIGTERM`), if any.
+    pub fn signal_name(&self) -> Option<&'static str> {
+        match self.signal.load(Ordering::SeqCst) {
+            SIGINT => Some("SIGINT"),
+            SIGTERM => Some("SIGTERM"),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,206 @@
+//! The saved state of a run is complete: a run restored from it at any pause goes on bit
+//! for bit as the run it was taken from (library level, every element kind with a
+//! history: contacts at impacts, joints; fixed and adaptive steps).
+//!
+//! `tests/restart.rs` checks the same through the binary and the files; here the
+//! comparison is of the nodal states and multipliers at every later step, and of the
+//! counters and element summaries at the end, for exact equality.
+
+use mecano::deck::load_deck;
+use mecano::elements::NodeState;
+use mecano::model::{Adaptive, Analysis, Model};
+use mecano::solver::state::IntegratorState;
+use mecano::solver::{self, Integrator, LoopState, Observer, Pause, Snapshot};
+use std::path::Path;
+
+fn deck(name: &str) -> Model {
+    load_deck(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("decks")
+            .join(name),
+    )
+    .expect("deck parses")
+}
+
+/// Every accepted state (step, time bits, nodes, multipliers); the saved states at the
+/// chosen steps.
+#[derive(Default)]
+struct Rec {
+    states: Vec<(u64, u64, Vec<NodeState>, Vec<u64>)>,
+    save_at: Vec<u64>,
+    saved: Vec<(u64, IntegratorState, LoopState)>,
+}
+
+impl Observer for Rec {
+    fn state(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let i = snap.integ;
+        self.states.push((
+            snap.step,
+            i.t.to_bits(),
+            i.nodes.clone(),
+            i.lambda.iter().map(|l| l.to_bits()).collect(),
+        ));
+        Ok(())
+    }
+
+    fn pause(&mut self, integ: &Integrator, ctl: &LoopState) -> std::io::Result<Pause> {
+        let s = integ.stats.steps;
+        if self.save_at.contains(&s) && !self.saved.iter().any(|x| x.0 == s) {
+            self.saved
+                .push((s, integ.save_state().expect("simplicial LU"), *ctl));
+        }
+        Ok(Pause::Continue)
+    }
+}
+
+fn summaries(i: &Integrator) -> Vec<Option<serde_json::Value>> {
+    i.sys.elements.iter().map(|e| e.summary()).collect()
+}
+
+/// Runs `model`, saving at `at` (fractions of its steps), restores each saved state into
+/// a fresh integrator and checks that the rest of the run is identical.
+fn check_restarts(name: &str, model: &Model, at: &[f64]) {
+    // A first run counts the steps.
+    let mut probe = Rec::default();
+    let rep = solver::run(model, &mut probe).expect("runs");
+    assert!(rep.failure.is_none(), "{name}: {:?}", rep.failure);
+    let n = rep.stats.steps;
+    let mut full = Rec {
+        save_at: at.iter().map(|f| (f * n as f64) as u64).collect(),
+        ..Rec::default()
+    };
+    let mut integ = solver::prepare(model).unwrap();
+    let rep = solver::run_prepared(model, &mut integ, &mut full).unwrap();
+    assert_eq!(full.saved.len(), at.len(), "{name}");
+    for (step, state, ctl) in std::mem::take(&mut full.saved) {
+        let mut again = solver::prepare(model).unwrap();
+        again.restore_state(state).unwrap();
+        let mut rest = Rec::default();
+        let rep2 = solver::run_from(model, &mut again, &mut rest, Some(ctl)).unwrap();
+        let expected: Vec<_> = full.states.iter().filter(|s| s.0 > step).cloned().collect();
+        assert_eq!(rest.states.len(), expected.len(), "{name} from step {step}");
+        for (a, b) in rest.states.iter().zip(&expected) {
+            assert!(
+                a == b,
+                "{name}: restarted at step {step}, step {} differs",
+                a.0
+            );
+        }
+        let strip = |mut s: solver::Stats| {
+            s.cpu_seconds = 0.0;
+            s
+        };
+        assert_eq!(
+            strip(rep2.stats),
+            strip(rep.stats),
+            "{name} from step {step}"
+        );
+        assert_eq!(
+            summaries(&again),
+            summaries(&integ),
+            "{name} from step {step}"
+        );
+    }
+}
+
+#[test]
+fn contacts_through_impacts_restart_bit_for_bit() {
+    // A bounce (touch, restart of the accelerations, release) and a cam with a follower.
+    let m = deck("contact_bounce.dat");
+    check_restarts("contact_bounce", &m, &[0.2, 0.45, 0.5, 0.55, 0.8]);
+    check_restarts("cam_follower", &deck("cam_follower.dat"), &[0.3, 0.7]);
+}
+
+#[test]
+fn joints_restart_bit_for_bit() {
+    // Hinges between beams, and a universal joint through its singular configuration
+    // (a failing run stops the test: it is checked to complete).
+    check_restarts(
+        "double_pendulum_beams",
+        &deck("double_pendulum_beams.dat"),
+        &[0.25, 0.6],
+    );
+    check_restarts("ujoint_singular", &deck("ujoint_singular.dat"), &[0.3, 0.6]);
+}
+
+#[test]
+fn adaptive_steps_restart_bit_for_bit() {
+    // The step ladder, the error estimate's proposal and a contact's step limits.
+    let mut m = deck("contact_bounce.dat");
+    if let Analysis::Dynamic {
+        step,
+        min_step,
+        max_step,
+        adaptive,
+        ..
+    } = &mut m.analysis
+    {
+        *min_step = *step / 1024.0;
+        *max_step = *step * 4.0;
+        *adaptive = Some(Adaptive {
+            tol_position: 1e-7,
+            tol_rotation: 1e-7,
+            max_growth: 2.0,
+        });
+    }
+    check_restarts("contact_bounce adaptive", &m, &[0.3, 0.5, 0.7]);
+}
+
+/// Sets the integrator's abort flag at the pause after step `at`, as a second Ctrl-C would.
+struct AbortAt {
+    at: u64,
+    flag: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl Observer for AbortAt {
+    fn state(&mut self, _snap: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn pause(&mut self, integ: &Integrator, _ctl: &LoopState) -> std::io::Result<Pause> {
+        if integ.stats.steps == self.at {
+            self.flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+        Ok(Pause::Continue)
+    }
+}
+
+#[test]
+fn an_abort_gives_up_the_step_under_way_and_is_not_a_failure() {
+    let m = deck("contact_bounce.dat");
+    let mut integ = solver::prepare(&m).unwrap();
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    integ.abort = Some(flag.clone());
+    let mut obs = AbortAt { at: 30, flag };
+    let rep = solver::run_prepared(&m, &mut integ, &mut obs).unwrap();
+    assert!(rep.failure.is_none(), "{:?}", rep.failure);
+    assert_eq!(rep.interrupted, Some(solver::Interruption::WithinStep));
+    assert_eq!(rep.stats.steps, 30, "the step after the abort is not taken");
+    assert_eq!(rep.stats.rejected_steps, 0, "nor counted as rejected");
+}
+
+/// Stops the run at the pause after step `at`.
+struct StopAt(u64);
+
+impl Observer for StopAt {
+    fn state(&mut self, _snap: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn pause(&mut self, integ: &Integrator, _ctl: &LoopState) -> std::io::Result<Pause> {
+        Ok(if integ.stats.steps == self.0 {
+            Pause::Stop
+        } else {
+            Pause::Continue
+        })
+    }
+}
+
+#[test]
+fn a_stop_at_a_pause_ends_at_that_step() {
+    let m = deck("contact_bounce.dat");
+    let rep = solver::run(&m, &mut StopAt(30)).unwrap();
+    assert!(rep.failure.is_none());
+    assert_eq!(rep.interrupted, Some(solver::Interruption::AtStep));
+    assert_eq!(rep.stats.steps, 30);
+}
