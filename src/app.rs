@@ -46,15 +46,19 @@ pub struct RunOptions {
     /// Wall time between two checkpoints, s (0: only at an interruption;
     /// [`DEFAULT_CHECKPOINT_SECONDS`] by default).
     pub checkpoint: f64,
+    /// `--refine k`: divide every beam into k times its elements (0 or 1: as written).
+    pub refine: u32,
 }
 
 impl RunOptions {
-    /// Options of a quiet run into `dir` with checkpoints every `checkpoint` seconds.
+    /// Options of a run into `dir` with checkpoints every `checkpoint` seconds, the deck's
+    /// mesh as written.
     pub fn new(out_dir: Option<PathBuf>, quiet: bool, checkpoint: f64) -> Self {
         RunOptions {
             out_dir,
             quiet,
             checkpoint,
+            refine: 1,
         }
     }
 }
@@ -67,20 +71,40 @@ pub fn load(path: &Path) -> Result<Model, u8> {
     })
 }
 
-/// Parses a deck read once, and names it: its path and the SHA-256 of the very text
-/// parsed (what a checkpoint is checked against).
-pub fn load_identified(path: &Path) -> Result<(Model, DeckIdentity), u8> {
+/// Parses a deck and refines its mesh by `refine` ([`Model::refine`]; 0 or 1: as
+/// written), printing diagnostics on error.
+pub fn load_refined(path: &Path, refine: u32) -> Result<Model, u8> {
+    let mut model = load(path)?;
+    apply_refine(path, &mut model, refine)?;
+    Ok(model)
+}
+
+fn apply_refine(path: &Path, model: &mut Model, refine: u32) -> Result<(), u8> {
+    if refine > 1 {
+        model.refine(refine).map_err(|e| {
+            eprintln!("error: {}: --refine {refine}: {e}", path.display());
+            EXIT_BAD_INPUT
+        })?;
+    }
+    Ok(())
+}
+
+/// Parses a deck read once, refines it by `refine`, and names it: its path, the SHA-256
+/// of the very text parsed and the refinement (what a checkpoint is checked against).
+pub fn load_identified(path: &Path, refine: u32) -> Result<(Model, DeckIdentity), u8> {
     let text = match std::fs::read(path).map(String::from_utf8) {
         Ok(Ok(t)) => t,
         // Unreadable or not UTF-8: the loader says so, with its diagnostics.
         _ => return Err(load(path).err().unwrap_or(EXIT_BAD_INPUT)),
     };
     let name = path.display().to_string();
-    let model = deck::parse_deck(&text, &name).map_err(|errs| {
+    let mut model = deck::parse_deck(&text, &name).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })?;
+    apply_refine(path, &mut model, refine)?;
     let id = DeckIdentity {
+        refine: refine.max(1),
         path: name,
         absolute: std::fs::canonicalize(path)
             .ok()
@@ -90,9 +114,10 @@ pub fn load_identified(path: &Path) -> Result<(Model, DeckIdentity), u8> {
     Ok((model, id))
 }
 
-/// `mecano-rs --check DECK`: parse, validate, build the system, print the summary.
-pub fn check(path: &Path) -> u8 {
-    let model = match load(path) {
+/// `mecano-rs --check DECK [--refine k]`: parse, validate, refine, build the system, print
+/// the summary (with the nodes and elements generated).
+pub fn check(path: &Path, refine: u32) -> u8 {
+    let model = match load_refined(path, refine) {
         Ok(m) => m,
         Err(code) => return code,
     };
@@ -153,7 +178,8 @@ fn start_session(
 ) -> Result<RunReport, (u8, String)> {
     let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
     let io_err = |e: std::io::Error| (EXIT_FAILED, format!("{}: {e}", dir.display()));
-    let writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(io_err)?;
+    let mut writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(io_err)?;
+    writer.refine = plan.as_ref().map_or(1, |p| p.deck.refine);
     // A checkpoint of an earlier run in this directory belongs to files just replaced.
     for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
         match std::fs::remove_file(dir.join(name)) {
@@ -260,7 +286,7 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let (model, id) = match load_identified(path) {
+    let (model, id) = match load_identified(path, opts.refine) {
         Ok(m) => m,
         Err(code) => return code,
     };

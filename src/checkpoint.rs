@@ -43,6 +43,8 @@ pub struct DeckIdentity {
     pub absolute: Option<String>,
     /// SHA-256 of the deck's text, lower-case hex.
     pub sha256: String,
+    /// The `--refine` factor the run divided every beam by (1: the mesh as written).
+    pub refine: u32,
 }
 
 /// The whole state of a run between two steps.
@@ -203,6 +205,7 @@ mod tests {
                 path: "t.dat".into(),
                 absolute: None,
                 sha256: sha256_hex(deck.as_bytes()),
+                refine: 1,
             },
             time: 0.0,
             step: 0,

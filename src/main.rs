@@ -51,6 +51,11 @@ struct Cli {
     /// directory, checkpoint.bin), seconds; 0: only at an interruption.
     #[arg(long, value_name = "SECONDS", default_value_t = mecano::app::DEFAULT_CHECKPOINT_SECONDS)]
     checkpoint: f64,
+    /// Refine the mesh: divide every BEAM of the deck into K times its elements (a BEAM
+    /// with `DIVIDE n` into K·n). Generated nodes and elements are numbered beyond the
+    /// deck's; the deck's nodes keep their numbers.
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    refine: u32,
 }
 
 /// Subcommands: one variant each, the logic in the library.
@@ -85,10 +90,13 @@ fn main() -> ExitCode {
         (Some(Command::Study(args)), _) => mecano::study::run(args),
         (Some(Command::Resume(args)), _) => mecano::app::resume(args),
         (Some(Command::Compare(args)), _) => mecano::compare::run(args),
-        (None, Some(deck)) if cli.check => mecano::app::check(deck),
+        (None, Some(deck)) if cli.check => mecano::app::check(deck, cli.refine),
         (None, Some(deck)) => mecano::app::run(
             deck,
-            &mecano::app::RunOptions::new(cli.out, cli.quiet, cli.checkpoint),
+            &mecano::app::RunOptions {
+                refine: cli.refine,
+                ..mecano::app::RunOptions::new(cli.out, cli.quiet, cli.checkpoint)
+            },
         ),
         // clap requires DECK when no subcommand is given.
         (None, None) => mecano::app::EXIT_BAD_INPUT,

@@ -79,7 +79,7 @@ pub fn resume(args: &ResumeArgs) -> u8 {
             .filter(|p| p.exists())
             .unwrap_or_else(|| PathBuf::from(&ck.deck.path))
     });
-    let (model, id) = match load_identified(&deck_path) {
+    let (model, id) = match load_identified(&deck_path, ck.deck.refine) {
         Ok(m) => m,
         Err(code) => {
             eprintln!(
@@ -131,6 +131,7 @@ pub fn resume(args: &ResumeArgs) -> u8 {
             );
         }
     };
+    writer.refine = ck.deck.refine;
     let vtk = match (model.output.vtk, &ck.vtk) {
         (false, _) => None,
         (true, Some(state)) => match VtkWriter::resume(dir, &model, &integ.sys, state) {

@@ -7,10 +7,12 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 mod ids;
+mod mesh;
 mod summary;
 
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
-pub use summary::{Effects, Summary};
+pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
+pub use summary::{Effects, Generated, Summary};
 
 use indexmap::IndexMap;
 use nalgebra::{Matrix3, Vector3};
@@ -494,6 +496,10 @@ pub struct Model {
     pub analysis: Analysis,
     /// Output requests.
     pub output: OutputRequest,
+    /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the
+    /// beam's number, in deck order; their generated nodes and elements are in `nodes` and
+    /// `elements` (see [`mesh`](self::Division) for the numbering).
+    pub divisions: IndexMap<ElementId, Division>,
 }
 
 #[cfg(test)]
