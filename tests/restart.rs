@@ -326,7 +326,7 @@ fn a_second_signal_ends_within_the_step_with_whole_rows_and_the_last_checkpoint_
 }
 
 #[test]
-fn resume_refuses_an_edited_deck_another_deck_a_complete_run_and_a_missing_checkpoint() {
+fn resume_refuses_an_edited_deck_another_deck_a_complete_or_failed_run_and_a_missing_checkpoint() {
     let base = tmp("refuse");
     let deck = base.join("deck.dat");
     std::fs::copy(DECK, &deck).unwrap();
@@ -371,6 +371,23 @@ fn resume_refuses_an_edited_deck_another_deck_a_complete_run_and_a_missing_check
     assert!(text(&o).contains("no checkpoint"), "{}", text(&o));
     let o = resume(&base.join("nowhere"));
     assert_eq!(o.status.code(), Some(2));
+    // A failed run keeps no checkpoint (a restart is bit for bit: it would fail again at
+    // the same step) and is refused, saying so.
+    let failed = base.join("failed");
+    let o = run(
+        &[
+            "decks/stab_diverge.dat",
+            "-q",
+            "-o",
+            failed.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(!failed.join("checkpoint.bin").exists());
+    let o = resume(&failed);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("would fail again"), "{}", text(&o));
     // A damaged checkpoint: refused by its checksum, not decoded.
     let (d2, o) = stopped_run("damaged", "signal:INT:100", "60");
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));

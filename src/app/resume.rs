@@ -67,6 +67,25 @@ pub fn resume(args: &ResumeArgs) -> u8 {
             "the run is complete (summary.json: \"complete\": true): nothing to resume",
         );
     }
+    if let Some(f) = summary
+        .as_ref()
+        .map(|s| &s["failure"])
+        .filter(|f| f.is_object())
+        && !dir.join(checkpoint::FILE_NAME).exists()
+    {
+        return refuse(
+            dir,
+            format!(
+                "the run failed ({}); a restart would fail again at the same step: change the deck and run it again",
+                f["message"]
+                    .as_str()
+                    .unwrap_or("see summary.json")
+                    .lines()
+                    .next()
+                    .unwrap_or("")
+            ),
+        );
+    }
     let ck = match checkpoint::read(dir) {
         Ok(c) => c,
         Err(e) => return refuse(dir, e),

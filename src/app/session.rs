@@ -197,9 +197,13 @@ impl Session<'_> {
             pb.finish_and_clear();
         }
         let integ = &self.integ;
+        // Whether the state could still go on: an interruption, or a disk that failed
+        // the writers (once space is freed, a restart from the last checkpoint works).
+        let mut resumable = false;
         let mut report = match result {
             Ok(r) => r,
             Err(solver::RunError::Output(e)) => {
+                resumable = true;
                 // The writer refused a row (non-finite value) or the disk failed: the run
                 // stops here, its files marked incomplete.
                 RunReport {
@@ -234,8 +238,9 @@ impl Session<'_> {
             v.finish(integ, report.interrupted.is_some())
                 .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
         }
-        if report.failure.is_none() && report.interrupted.is_none() {
-            // A complete run is not resumed: its checkpoint is of no more use.
+        if report.interrupted.is_none() && !resumable {
+            // A complete run is not resumed, and a failed one would fail again at the same
+            // step (a restart is bit for bit): its checkpoint is of no more use.
             for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
                 let _ = std::fs::remove_file(dir.join(name));
             }
