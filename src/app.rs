@@ -25,25 +25,64 @@ pub struct RunOptions {
     pub out_dir: Option<PathBuf>,
     /// No progress bar, no summary on standard output.
     pub quiet: bool,
+    /// Parameter overrides (`--set name=value`), in command-line order (the last wins).
+    pub set: Vec<(String, f64)>,
+}
+
+/// Reads `name=value` (`--set`): a parameter name and a number or an expression of numbers
+/// (`E=2.1e11`, `h=1e-4/2`).
+pub fn parse_set(arg: &str) -> Result<(String, f64), String> {
+    let (name, value) = arg
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{arg}`"))?;
+    let name = name.trim().trim_start_matches('$');
+    let valid = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !valid {
+        return Err(format!("`{name}` is not a parameter name"));
+    }
+    let v = deck::eval_constant(value.trim())
+        .ok_or_else(|| format!("`{value}` is not a finite number or expression of numbers"))?;
+    Ok((name.to_string(), v))
 }
 
 /// Parses a deck, printing diagnostics on error.
 pub fn load(path: &Path) -> Result<Model, u8> {
-    deck::load_deck(path).map_err(|errs| {
+    load_with(path, &[])
+}
+
+/// Parses a deck with parameter overrides, printing diagnostics on error.
+pub fn load_with(path: &Path, set: &[(String, f64)]) -> Result<Model, u8> {
+    deck::load_deck_with(path, set).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })
 }
 
-/// `mecano-rs --check DECK`: parse, validate, build the system, print the summary.
-pub fn check(path: &Path) -> u8 {
-    let model = match load(path) {
+/// `mecano-rs --check DECK`: parse, validate, build the system, print the summary and the
+/// parameters with their values (`--set` overrides marked).
+pub fn check(path: &Path, set: &[(String, f64)]) -> u8 {
+    let model = match load_with(path, set) {
         Ok(m) => m,
         Err(code) => return code,
     };
     let mut out = std::io::stdout().lock();
     // A closed pipe (`mecano-rs --check deck | head`) is not an error of ours: ignore it.
     let _ = write!(out, "{}", model.summary());
+    if !model.parameters.is_empty() {
+        let _ = writeln!(out, "parameters:  {}", model.parameters.len());
+        for (name, v) in &model.parameters {
+            let mark = if set.iter().any(|(n, _)| n == name) {
+                "   (--set)"
+            } else {
+                ""
+            };
+            let _ = writeln!(out, "  {name} = {v:?}{mark}");
+        }
+    }
     match solver::prepare(&model) {
         Ok(integ) => {
             let _ = writeln!(
@@ -155,7 +194,7 @@ pub fn run_model(
 
 /// `mecano-rs DECK`: parse, run, write; returns the exit code.
 pub fn run(path: &Path, opts: &RunOptions) -> u8 {
-    let model = match load(path) {
+    let model = match load_with(path, &opts.set) {
         Ok(m) => m,
         Err(code) => return code,
     };

@@ -37,6 +37,9 @@ struct Cli {
     /// No progress bar and no closing summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Override a deck parameter (PARAMETERS section): `--set E=2.1e10`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = mecano::app::parse_set)]
+    set: Vec<(String, f64)>,
 }
 
 /// Subcommands: one variant each, the logic in the library.
@@ -55,12 +58,13 @@ fn main() -> ExitCode {
     let code = match (&cli.command, &cli.deck) {
         (Some(Command::Plot(args)), _) => mecano::plot::run(args),
         (Some(Command::Study(args)), _) => mecano::study::run(args),
-        (None, Some(deck)) if cli.check => mecano::app::check(deck),
+        (None, Some(deck)) if cli.check => mecano::app::check(deck, &cli.set),
         (None, Some(deck)) => mecano::app::run(
             deck,
             &mecano::app::RunOptions {
                 out_dir: cli.out,
                 quiet: cli.quiet,
+                set: cli.set.clone(),
             },
         ),
         // clap requires DECK when no subcommand is given.

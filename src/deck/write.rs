@@ -70,6 +70,13 @@ fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
 pub fn write_deck(model: &Model) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "TITLE {}", model.title);
+    // Parameters with their values in force; every field below is written with its value.
+    if !model.parameters.is_empty() {
+        s.push_str("PARAMETERS\n");
+        for (name, v) in &model.parameters {
+            let _ = writeln!(s, "  {name} {v:?}");
+        }
+    }
     if !model.materials.is_empty() {
         s.push_str("MATERIALS\n");
         for m in model.materials.values() {

@@ -494,6 +494,9 @@ pub struct Model {
     pub analysis: Analysis,
     /// Output requests.
     pub output: OutputRequest,
+    /// Deck parameters (`PARAMETERS`), name → value in force (the deck's value or an
+    /// override), in deck order. The fields that use them already hold their values.
+    pub parameters: IndexMap<String, f64>,
 }
 
 #[cfg(test)]

@@ -119,6 +119,7 @@ pub(crate) fn build_model(
     cards: &[Card<'_>],
     errors: Vec<DeckError>,
     empty: bool,
+    parameters: IndexMap<String, f64>,
 ) -> Result<Model, Vec<DeckError>> {
     let mut b = Builder {
         src,
@@ -211,5 +212,6 @@ pub(crate) fn build_model(
         initial: b.initial,
         analysis,
         output: b.output.map(|o| o.0).unwrap_or_default(),
+        parameters,
     })
 }
