@@ -18,3 +18,4 @@ pub mod rotation;
 pub mod scenes;
 pub mod solver;
 pub mod study;
+pub mod sweep;

@@ -51,6 +51,9 @@ enum Command {
     /// report CPU time, steps, Newton iterations and errors per time window, draw error
     /// against CPU time.
     Study(mecano::study::StudyArgs),
+    /// Parameter study: run the cases of a plan (TOML) in parallel, or emit a Slurm job
+    /// array, and collect sweep.csv, statistics and figures.
+    Sweep(mecano::sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
     let code = match (&cli.command, &cli.deck) {
         (Some(Command::Plot(args)), _) => mecano::plot::run(args),
         (Some(Command::Study(args)), _) => mecano::study::run(args),
+        (Some(Command::Sweep(args)), _) => mecano::sweep::run(args),
         (None, Some(deck)) if cli.check => mecano::app::check(deck, &cli.set),
         (None, Some(deck)) => mecano::app::run(
             deck,

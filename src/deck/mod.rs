@@ -374,6 +374,11 @@ pub fn parse_deck_with(
         .map_err(|errors| DeckErrors::new(source, file_name, errors))
 }
 
+/// Whether `name` is a valid parameter name (a letter or `_`, then letters, digits, `_`).
+pub fn is_parameter_name(name: &str) -> bool {
+    expr::is_name(name)
+}
+
 /// The value of `text` read as an expression of numbers (no parameters), e.g. the value
 /// of `--set h=1e-4/2`; `None` when it is not a finite number or expression.
 pub fn eval_constant(text: &str) -> Option<f64> {
