@@ -49,7 +49,7 @@ pub fn timing_columns(plan: &Plan) -> Vec<String> {
 pub fn records(plan: &Plan) -> Vec<CaseRecord> {
     (0..plan.cases.len())
         .map(|i| {
-            finished(&plan.case_dir(i), &plan.cases[i]).unwrap_or_else(|| CaseRecord {
+            finished(plan, i).unwrap_or_else(|| CaseRecord {
                 case: i,
                 values: plan.cases[i].clone(),
                 status: Status::Missing,
@@ -58,6 +58,7 @@ pub fn records(plan: &Plan) -> Vec<CaseRecord> {
                 time: 0.0,
                 cpu_s: 0.0,
                 quantities: vec![None; plan.quantities.len()],
+                quantity_names: Vec::new(),
             })
         })
         .collect()

@@ -9,7 +9,7 @@
 //!   5 to 40) and its scatter plot against each random parameter
 //!   (`<quantity>_vs_<parameter>.svg`).
 //!
-//! Only the cases that ended `ok` are drawn. Axes on a log scale are drawn in log10 of the
+//! Each figure is written as `.svg` and `.png`. Only the cases that ended `ok` are drawn. Axes on a log scale are drawn in log10 of the
 //! value, their ticks labelled with the value.
 
 use super::SweepError;
@@ -87,14 +87,19 @@ impl Axis {
     }
 
     fn label(&self, v: f64) -> String {
-        let x = if self.log { 10f64.powf(v) } else { v };
-        if x != 0.0 && (x.abs() >= 1e4 || x.abs() < 1e-2) {
-            format!("{x:.1e}")
+        if self.log {
+            let x = 10f64.powf(v);
+            return format!("{x:.1e}");
+        }
+        // Enough digits to tell ticks about (hi − lo)/10 apart.
+        let step = ((self.hi - self.lo) / 10.0).abs().max(f64::MIN_POSITIVE);
+        let big = self.lo.abs().max(self.hi.abs());
+        if big >= 1e4 || big < 1e-2 {
+            let digits = ((big / step).log10().ceil() as usize).clamp(1, 10);
+            format!("{v:.*e}", digits - 1)
         } else {
-            format!("{:.3}", x)
-                .trim_end_matches('0')
-                .trim_end_matches('.')
-                .to_string()
+            let decimals = (-step.log10().floor()).max(0.0) as usize;
+            format!("{v:.*}", decimals.min(12))
         }
     }
 }
@@ -109,15 +114,41 @@ fn wide(values: &[f64]) -> bool {
 
 type Series = (String, Vec<(f64, f64)>, RGBColor, bool);
 
+/// Draws into `file` (`.svg`) and its `.png` twin.
 fn draw_xy(
     file: &PathBuf,
+    title: &str,
+    names: (&str, &str),
+    axes: (&Axis, &Axis),
+    series: &[Series],
+) -> Result<(), String> {
+    crate::plot::ensure_font();
+    xy_on(
+        SVGBackend::new(file, SIZE).into_drawing_area(),
+        title,
+        names,
+        axes,
+        series,
+    )?;
+    let png = file.with_extension("png");
+    xy_on(
+        BitMapBackend::new(&png, SIZE).into_drawing_area(),
+        title,
+        names,
+        axes,
+        series,
+    )
+}
+
+const SIZE: (u32, u32) = (800, 520);
+
+fn xy_on<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
     (xname, yname): (&str, &str),
     (xa, ya): (&Axis, &Axis),
     series: &[Series],
 ) -> Result<(), String> {
-    crate::plot::ensure_font();
-    let root = SVGBackend::new(file, (800, 520)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
@@ -154,6 +185,7 @@ fn draw_xy(
     }
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()
@@ -161,8 +193,30 @@ fn draw_xy(
     root.present().map_err(|e| e.to_string())
 }
 
+/// Draws into `file` (`.svg`) and its `.png` twin.
 fn draw_hist(file: &PathBuf, title: &str, name: &str, x: &[f64]) -> Result<(), String> {
     crate::plot::ensure_font();
+    hist_on(
+        SVGBackend::new(file, SIZE).into_drawing_area(),
+        title,
+        name,
+        x,
+    )?;
+    let png = file.with_extension("png");
+    hist_on(
+        BitMapBackend::new(&png, SIZE).into_drawing_area(),
+        title,
+        name,
+        x,
+    )
+}
+
+fn hist_on<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    name: &str,
+    x: &[f64],
+) -> Result<(), String> {
     let n = x.len();
     let bins = ((n as f64).sqrt().ceil() as usize).clamp(5, 40);
     let (lo, hi) = x
@@ -182,7 +236,6 @@ fn draw_hist(file: &PathBuf, title: &str, name: &str, x: &[f64]) -> Result<(), S
         counts[k] += 1;
     }
     let top = f64::from(counts.iter().copied().max().unwrap_or(1)) * 1.1;
-    let root = SVGBackend::new(file, (800, 520)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))

@@ -5,11 +5,15 @@
 //! name = "z12"          # the column's name in sweep.csv
 //! node = 12             # node_12.csv (or element = 23: element_23.csv)
 //! column = "z"          # a column of that file (header names)
-//! stat = "max_abs"      # max | min | max_abs | value | last | first_time_above
+//! stat = "max_abs"      # max | min | max_abs | value | last
+//!                       # | first_time_above | first_time_below
 //! from = 0.0            # window [from, to] in s (default: the whole run)
 //! to = 1.0
 //! at = 0.5              # stat = "value": the column at t (linear interpolation)
-//! threshold = 0.0       # stat = "first_time_above": first t where column > threshold
+//! threshold = 0.0       # first_time_above / _below: the first time the column crosses
+//!                       # the threshold (default 0) upwards / downwards, interpolated
+//!                       # linearly between the two rows that bracket the crossing (the
+//!                       # first row when it is already past)
 //!
 //! [[quantity]]
 //! name = "impacts"
@@ -68,8 +72,10 @@ pub enum Stat {
     Value(f64),
     /// The last value in the window.
     Last,
-    /// The first time in the window where the column exceeds the threshold.
+    /// The first time in the window where the column rises above the threshold.
     FirstTimeAbove(f64),
+    /// The first time in the window where the column falls below the threshold.
+    FirstTimeBelow(f64),
 }
 
 /// From summary.json.
@@ -177,9 +183,10 @@ impl Quantity {
                 Stat::Value(q.at.ok_or(format!("{ctx}: stat = \"value\" needs `at`"))?)
             }
             Some("first_time_above") => Stat::FirstTimeAbove(q.threshold.unwrap_or(0.0)),
+            Some("first_time_below") => Stat::FirstTimeBelow(q.threshold.unwrap_or(0.0)),
             Some(o) => {
                 return Err(format!(
-                    "{ctx}: stat = \"{o}\": expected max, min, max_abs, value, last or first_time_above"
+                    "{ctx}: stat = \"{o}\": expected max, min, max_abs, value, last, first_time_above or first_time_below"
                 ));
             }
             None => return Err(format!("{ctx}: needs `stat`")),
@@ -274,7 +281,8 @@ pub fn column_stat(t: &[f64], y: &[f64], stat: Stat, from: f64, to: f64) -> Opti
         Stat::Min => inside().map(|p| *p.1).reduce(f64::min),
         Stat::MaxAbs => inside().map(|p| p.1.abs()).reduce(f64::max),
         Stat::Last => inside().last().map(|p| *p.1),
-        Stat::FirstTimeAbove(th) => inside().find(|p| *p.1 > th).map(|p| *p.0),
+        Stat::FirstTimeAbove(th) => crossing(inside(), |y| y > th, th),
+        Stat::FirstTimeBelow(th) => crossing(inside(), |y| y < th, th),
         Stat::Value(at) => {
             if at < from || at > to {
                 return None;
@@ -287,6 +295,23 @@ pub fn column_stat(t: &[f64], y: &[f64], stat: Stat, from: f64, to: f64) -> Opti
             Some(y[k - 1] + s * (y[k] - y[k - 1]))
         }
     }
+}
+
+/// The first time `past(y)` holds, interpolated linearly from the row before.
+fn crossing<'a>(
+    mut rows: impl Iterator<Item = (&'a f64, &'a f64)>,
+    past: impl Fn(f64) -> bool,
+    th: f64,
+) -> Option<f64> {
+    let mut prev: Option<(f64, f64)> = None;
+    rows.find_map(|(&t, &y)| {
+        let hit = past(y).then(|| match prev {
+            Some((t0, y0)) if y != y0 => t0 + (th - y0) / (y - y0) * (t - t0),
+            _ => t,
+        });
+        prev = Some((t, y));
+        hit
+    })
 }
 
 #[cfg(test)]
@@ -303,9 +328,14 @@ mod tests {
         assert_eq!(column_stat(&t, &y, Stat::Min, 0.0, 0.3), Some(-3.0));
         assert_eq!(column_stat(&t, &y, Stat::MaxAbs, 0.0, 0.3), Some(3.0));
         assert_eq!(column_stat(&t, &y, Stat::Last, 0.0, 0.35), Some(1.0));
+        // 1.5 is crossed between (0.1, −3) and (0.2, 2): at 0.1 + 4.5/5 · 0.1 = 0.19.
+        let up = column_stat(&t, &y, Stat::FirstTimeAbove(1.5), -inf, inf).expect("crossed");
+        assert!((up - 0.19).abs() < 1e-12, "{up}");
+        let down = column_stat(&t, &y, Stat::FirstTimeBelow(-1.0), -inf, inf).expect("crossed");
+        assert!((down - 0.1 / 3.0).abs() < 1e-12, "{down}");
         assert_eq!(
-            column_stat(&t, &y, Stat::FirstTimeAbove(1.5), -inf, inf),
-            Some(0.2)
+            column_stat(&t, &y, Stat::FirstTimeBelow(1.0), 0.0, inf),
+            Some(0.0)
         );
         assert_eq!(
             column_stat(&t, &y, Stat::FirstTimeAbove(9.0), -inf, inf),

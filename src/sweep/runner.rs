@@ -65,20 +65,71 @@ pub struct CaseRecord {
     pub cpu_s: f64,
     /// Quantities of interest, in plan order (`None`: does not exist for this case).
     pub quantities: Vec<Option<f64>>,
+    /// Their names (a plan whose quantities changed recomputes them from the case's files).
+    #[serde(default)]
+    pub quantity_names: Vec<String>,
 }
 
-/// The record of a finished case, if `dir` holds one for these parameter values.
-pub fn finished(dir: &Path, values: &[f64]) -> Option<CaseRecord> {
+/// The record of finished case `i`, if its directory holds one for its parameter values.
+/// When the plan's quantities differ from those recorded, they are computed again from
+/// the case's files (no rerun) and the record rewritten.
+pub fn finished(plan: &Plan, i: usize) -> Option<CaseRecord> {
+    let dir = plan.case_dir(i);
     let text = std::fs::read_to_string(dir.join("case.json")).ok()?;
-    let rec: CaseRecord = serde_json::from_str(&text).ok()?;
-    (rec.values == values).then_some(rec)
+    let mut rec: CaseRecord = serde_json::from_str(&text).ok()?;
+    if rec.values != plan.cases[i] {
+        return None;
+    }
+    if rec.quantity_names != names(plan) {
+        quantify(plan, &dir, &mut rec);
+        write_record(&dir, &rec).ok()?;
+    }
+    Some(rec)
+}
+
+fn names(plan: &Plan) -> Vec<String> {
+    plan.quantities.iter().map(|q| q.name.clone()).collect()
+}
+
+/// Computes the plan's quantities from the case's files (runs that ended ok or failed).
+fn quantify(plan: &Plan, dir: &Path, rec: &mut CaseRecord) {
+    rec.quantity_names = names(plan);
+    rec.quantities = vec![None; plan.quantities.len()];
+    if rec.status == Status::QuantityError {
+        rec.status = Status::Ok;
+        rec.diagnosis.clear();
+    }
+    if !matches!(rec.status, Status::Ok | Status::Failed) {
+        return;
+    }
+    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    for (k, q) in plan.quantities.iter().enumerate() {
+        match q.eval(dir, &summary) {
+            Ok(v) => rec.quantities[k] = v,
+            Err(msg) => {
+                if rec.status == Status::Ok {
+                    rec.status = Status::QuantityError;
+                    rec.diagnosis = one_line(&msg);
+                }
+            }
+        }
+    }
+}
+
+fn write_record(dir: &Path, rec: &CaseRecord) -> std::io::Result<()> {
+    let text = serde_json::to_string_pretty(rec).unwrap_or_default();
+    let tmp = dir.join("case.json.tmp");
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, dir.join("case.json"))
 }
 
 /// Runs case `i` unless it is finished; returns its record.
 pub fn run_case(plan: &Plan, i: usize) -> Result<CaseRecord, SweepError> {
     let dir = plan.case_dir(i);
-    let values = &plan.cases[i];
-    if let Some(rec) = finished(&dir, values) {
+    if let Some(rec) = finished(plan, i) {
         return Ok(rec);
     }
     if dir.exists() {
@@ -119,6 +170,7 @@ fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError
         time: 0.0,
         cpu_s: 0.0,
         quantities: vec![None; plan.quantities.len()],
+        quantity_names: names(plan),
     };
     let deck_name = plan.deck.display().to_string();
     match crate::deck::load_deck_with(&plan.deck, &plan.overrides(i)) {
@@ -139,28 +191,11 @@ fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError
                     rec.status = Status::Failed;
                     rec.diagnosis = one_line(&f.to_string());
                 }
-                let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
-                    .ok()
-                    .and_then(|t| serde_json::from_str(&t).ok())
-                    .unwrap_or_default();
-                for (k, q) in plan.quantities.iter().enumerate() {
-                    match q.eval(dir, &summary) {
-                        Ok(v) => rec.quantities[k] = v,
-                        Err(msg) => {
-                            if rec.status == Status::Ok {
-                                rec.status = Status::QuantityError;
-                                rec.diagnosis = one_line(&msg);
-                            }
-                        }
-                    }
-                }
+                quantify(plan, dir, &mut rec);
             }
         },
     }
-    let text = serde_json::to_string_pretty(&rec).unwrap_or_default();
-    let tmp = dir.join("case.json.tmp");
-    std::fs::write(&tmp, text).map_err(io)?;
-    std::fs::rename(&tmp, dir.join("case.json")).map_err(io)?;
+    write_record(dir, &rec).map_err(io)?;
     Ok(rec)
 }
 
@@ -192,7 +227,7 @@ pub fn run_local(
     let pending: Vec<usize> = which
         .iter()
         .copied()
-        .filter(|&i| finished(&plan.case_dir(i), &plan.cases[i]).is_none())
+        .filter(|&i| finished(plan, i).is_none())
         .collect();
     let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
         let pb = indicatif::ProgressBar::new(pending.len() as u64);
