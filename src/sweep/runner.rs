@@ -178,7 +178,7 @@ fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError
             rec.status = Status::BadInput;
             rec.diagnosis = one_line(&deck_errors_text(&errs));
         }
-        Ok(model) => match app::run_model(&model, &deck_name, dir, true) {
+        Ok(model) => match run_model(&model, &deck_name, dir) {
             Err((_, msg)) => {
                 rec.status = Status::BadInput;
                 rec.diagnosis = one_line(&msg);
@@ -197,6 +197,47 @@ fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError
     }
     write_record(dir, &rec).map_err(io)?;
     Ok(rec)
+}
+
+/// [`app::run_model`] for a case: no progress bar, no VTK, and, when the deck writes every
+/// step (`OUTPUT EVERY 1`, the default), *every accepted step*, also the extra steps of
+/// contact events that a plain run leaves out to keep its rows on the instants k·h: the
+/// quantities of interest must see the impacts (with h = 5e-5 s on the pendulum the whole
+/// first contact falls between two grid instants). With `EVERY n > 1` the deck's sampling
+/// is kept (fewer rows for large sweeps; the quantities see those rows only).
+fn run_model(
+    model: &crate::model::Model,
+    deck_name: &str,
+    dir: &Path,
+) -> Result<crate::solver::RunReport, (u8, String)> {
+    use crate::solver;
+    let mut integ = solver::prepare(model).map_err(|e| (app::EXIT_BAD_INPUT, e.to_string()))?;
+    let io = |e: std::io::Error| (app::EXIT_FAILED, format!("{}: {e}", dir.display()));
+    let mut writer = crate::output::Writer::create(dir, deck_name, model, &integ.sys).map_err(io)?;
+    if model.output.every <= 1 {
+        writer.every_accepted_step();
+    }
+    let mut report = match solver::run_prepared(model, &mut integ, &mut writer) {
+        Ok(r) => r,
+        Err(solver::RunError::Output(e)) => solver::RunReport {
+            stats: integ.stats,
+            time: integ.t,
+            failure: Some(solver::Failure {
+                time: integ.t,
+                step: 0.0,
+                reason: solver::FailureReason::NotFinite,
+                residual_history: vec![],
+                worst: format!("output: {e}"),
+                worst_value: 0.0,
+                reference_force: 0.0,
+                diagnoses: Box::default(),
+            }),
+        },
+        Err(e) => return Err((app::EXIT_BAD_INPUT, e.to_string())),
+    };
+    report.stats = integ.stats;
+    writer.finish(&integ, &report).map_err(io)?;
+    Ok(report)
 }
 
 fn deck_errors_text(errs: &crate::deck::DeckErrors) -> String {
