@@ -94,7 +94,7 @@ impl Axis {
         // Enough digits to tell ticks about (hi − lo)/10 apart.
         let step = ((self.hi - self.lo) / 10.0).abs().max(f64::MIN_POSITIVE);
         let big = self.lo.abs().max(self.hi.abs());
-        if big >= 1e4 || big < 1e-2 {
+        if !(1e-2..1e4).contains(&big) {
             let digits = ((big / step).log10().ceil() as usize).clamp(1, 10);
             format!("{v:.*e}", digits - 1)
         } else {

@@ -280,7 +280,7 @@ pub fn column_stat(t: &[f64], y: &[f64], stat: Stat, from: f64, to: f64) -> Opti
         Stat::Max => inside().map(|p| *p.1).reduce(f64::max),
         Stat::Min => inside().map(|p| *p.1).reduce(f64::min),
         Stat::MaxAbs => inside().map(|p| p.1.abs()).reduce(f64::max),
-        Stat::Last => inside().last().map(|p| *p.1),
+        Stat::Last => inside().next_back().map(|p| *p.1),
         Stat::FirstTimeAbove(th) => crossing(inside(), |y| y > th, th),
         Stat::FirstTimeBelow(th) => crossing(inside(), |y| y < th, th),
         Stat::Value(at) => {

@@ -213,7 +213,8 @@ fn run_model(
     use crate::solver;
     let mut integ = solver::prepare(model).map_err(|e| (app::EXIT_BAD_INPUT, e.to_string()))?;
     let io = |e: std::io::Error| (app::EXIT_FAILED, format!("{}: {e}", dir.display()));
-    let mut writer = crate::output::Writer::create(dir, deck_name, model, &integ.sys).map_err(io)?;
+    let mut writer =
+        crate::output::Writer::create(dir, deck_name, model, &integ.sys).map_err(io)?;
     if model.output.every <= 1 {
         writer.every_accepted_step();
     }

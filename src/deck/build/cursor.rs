@@ -97,13 +97,12 @@ impl<'t, 'a> Cursor<'t, 'a> {
         if let Some(e) = &t.bad_expr {
             return Err((**e).clone());
         }
+        let whole = |v: &f64| v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(v);
         if let Some(v) = t
             .number
-            .filter(|_| super::super::expr::looks_like_expression(t.text))
+            .filter(|v| super::super::expr::looks_like_expression(t.text) && whole(v))
         {
-            if v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v) {
-                return Ok((v as u32, t.span));
-            }
+            return Ok((v as u32, t.span));
         }
         let digits = t.text.strip_prefix('+').unwrap_or(t.text);
         let ok = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
