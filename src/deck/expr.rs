@@ -397,6 +397,21 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// Any text: a value or a located error, never a panic, and an error's span lies
+        /// within the text on character boundaries.
+        #[test]
+        fn never_panics(s in "[-+*/^()$a-zE_0-9. é,]{0,24}") {
+            match ev(&s) {
+                Ok(v) => proptest::prop_assert!(v.is_finite()),
+                Err(e) => {
+                    proptest::prop_assert!(e.at + e.len <= s.len());
+                    proptest::prop_assert!(s.is_char_boundary(e.at) && s.is_char_boundary(e.at + e.len));
+                }
+            }
+        }
+    }
+
     #[test]
     fn names() {
         assert!(is_name("E") && is_name("_x1") && is_name("k_cont"));
