@@ -366,3 +366,48 @@ fn bad_plans_and_parameters_exit_2_with_a_message() {
     assert_eq!(r.status.code(), Some(2), "clap rejects a malformed --set");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_diverging_case_is_recorded_with_its_diagnosis() {
+    let dir = tmp("diverge");
+    // decks/stab_diverge.dat (an absurd tip load on a cantilever: Newton fails) with the
+    // load as a parameter: 1 N runs, 1e12 N fails.
+    let deck = std::fs::read_to_string(root().join("decks/stab_diverge.dat")).expect("deck");
+    let deck = deck
+        .replace("FORCE 5  0 1e12 0", "FORCE 5  0 $F 0")
+        .replace("END 1 MAXIT 10", "END 0.05 MAXIT 10")
+        .replace("MATERIALS\n", "PARAMETERS\n  F 1e12\nMATERIALS\n");
+    assert!(
+        deck.contains("$F") && deck.contains("PARAMETERS"),
+        "the deck changed: {deck}"
+    );
+    std::fs::write(dir.join("d.dat"), deck).expect("write");
+    std::fs::write(
+        dir.join("p.toml"),
+        "deck = \"d.dat\"\n[[parameter]]\nname = \"F\"\nvalues = [1, 1e12]\n\
+         [[quantity]]\nname = \"y5\"\nnode = 5\ncolumn = \"y\"\nstat = \"max\"\n",
+    )
+    .expect("write");
+    let out = dir.join("out");
+    let r = run(&[
+        "sweep",
+        dir.join("p.toml").to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+        "-q",
+    ]);
+    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    let t = rows(&out);
+    let (st, diag) = (col(&t, "status"), col(&t, "diagnosis"));
+    assert_eq!(t[1][st], "ok");
+    assert!(t[1][diag].is_empty());
+    assert_eq!(t[2][st], "failed");
+    assert!(
+        t[2][diag].to_lowercase().contains("newton"),
+        "{}",
+        t[2][diag]
+    );
+    // The histories up to the failure are kept and the quantity computed on them.
+    assert!(!t[2][col(&t, "y5")].is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
