@@ -63,6 +63,7 @@ fn write_cases(plan: &Plan) {
             cpu_s: 1.0,
             quantities: vec![Some(plan.cases[i][0] * 1e-13), Some(0.5)],
             quantity_names: vec!["z".into(), "t".into()],
+            deck_hash: plan.deck_hash.clone(),
         };
         std::fs::write(
             dir.join("case.json"),

@@ -409,5 +409,20 @@ fn a_diverging_case_is_recorded_with_its_diagnosis() {
     );
     // The histories up to the failure are kept and the quantity computed on them.
     assert!(!t[2][col(&t, "y5")].is_empty());
+    // Another deck text (even a comment) means other cases: all run again.
+    let d = dir.join("d.dat");
+    let old = std::fs::read_to_string(&d).expect("read");
+    std::fs::write(&d, format!("! changed\n{old}")).expect("write");
+    let r = run(&[
+        "sweep",
+        dir.join("p.toml").to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        text(&r).contains("2 of 2 cases run (0 already finished)"),
+        "{}",
+        text(&r)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

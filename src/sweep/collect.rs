@@ -59,6 +59,7 @@ pub fn records(plan: &Plan) -> Vec<CaseRecord> {
                 cpu_s: 0.0,
                 quantities: vec![None; plan.quantities.len()],
                 quantity_names: Vec::new(),
+                deck_hash: String::new(),
             })
         })
         .collect()

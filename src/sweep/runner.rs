@@ -4,7 +4,7 @@
 //! A case runs the plan's deck with the case's parameter values (`--set`) into its own
 //! directory, computes the quantities of interest from what the run wrote, and records it
 //! all in `case.json`, written last (atomically): a case directory with a `case.json` of
-//! the same parameter values is *finished* — completed or failed with its diagnosis — and
+//! the same parameter values and deck text (hash) is *finished* — completed or failed with its diagnosis — and
 //! is skipped when the plan runs again; a directory without one was interrupted and is run
 //! again ([`restart_incomplete_case`]). A failed case (Newton divergence, non-finite
 //! values, values the deck rejects) is recorded and the others go on.
@@ -68,6 +68,9 @@ pub struct CaseRecord {
     /// Their names (a plan whose quantities changed recomputes them from the case's files).
     #[serde(default)]
     pub quantity_names: Vec<String>,
+    /// The hash of the deck's text it ran with ([`super::plan::fnv1a`]).
+    #[serde(default)]
+    pub deck_hash: String,
 }
 
 /// The record of finished case `i`, if its directory holds one for its parameter values.
@@ -77,7 +80,7 @@ pub fn finished(plan: &Plan, i: usize) -> Option<CaseRecord> {
     let dir = plan.case_dir(i);
     let text = std::fs::read_to_string(dir.join("case.json")).ok()?;
     let mut rec: CaseRecord = serde_json::from_str(&text).ok()?;
-    if rec.values != plan.cases[i] {
+    if rec.values != plan.cases[i] || rec.deck_hash != plan.deck_hash {
         return None;
     }
     if rec.quantity_names != names(plan) {
@@ -171,6 +174,7 @@ fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError
         cpu_s: 0.0,
         quantities: vec![None; plan.quantities.len()],
         quantity_names: names(plan),
+        deck_hash: plan.deck_hash.clone(),
     };
     let deck_name = plan.deck.display().to_string();
     match crate::deck::load_deck_with(&plan.deck, &plan.overrides(i)) {
