@@ -48,6 +48,8 @@ pub struct RunOptions {
     pub checkpoint: f64,
     /// `--refine k`: divide every beam into k times its elements (0 or 1: as written).
     pub refine: u32,
+    /// Parameter overrides (`--set name=value`), in command-line order (the last wins).
+    pub set: Vec<(String, f64)>,
 }
 
 impl RunOptions {
@@ -59,13 +61,39 @@ impl RunOptions {
             quiet,
             checkpoint,
             refine: 1,
+            set: Vec::new(),
         }
     }
 }
 
+/// Reads `name=value` (`--set`): a parameter name and a number or an expression of numbers
+/// (`E=2.1e11`, `h=1e-4/2`).
+pub fn parse_set(arg: &str) -> Result<(String, f64), String> {
+    let (name, value) = arg
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{arg}`"))?;
+    let name = name.trim().trim_start_matches('$');
+    let valid = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !valid {
+        return Err(format!("`{name}` is not a parameter name"));
+    }
+    let v = deck::eval_constant(value.trim())
+        .ok_or_else(|| format!("`{value}` is not a finite number or expression of numbers"))?;
+    Ok((name.to_string(), v))
+}
+
 /// Parses a deck, printing diagnostics on error.
 pub fn load(path: &Path) -> Result<Model, u8> {
-    deck::load_deck(path).map_err(|errs| {
+    load_with(path, &[])
+}
+
+/// Parses a deck with parameter overrides, printing diagnostics on error.
+pub fn load_with(path: &Path, set: &[(String, f64)]) -> Result<Model, u8> {
+    deck::load_deck_with(path, set).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })
@@ -74,7 +102,12 @@ pub fn load(path: &Path) -> Result<Model, u8> {
 /// Parses a deck and refines its mesh by `refine` ([`Model::refine`]; 0 or 1: as
 /// written), printing diagnostics on error.
 pub fn load_refined(path: &Path, refine: u32) -> Result<Model, u8> {
-    let mut model = load(path)?;
+    load_variant(path, &[], refine)
+}
+
+/// Parses a deck with parameter overrides (`--set`) and refines its mesh by `refine`.
+pub fn load_variant(path: &Path, set: &[(String, f64)], refine: u32) -> Result<Model, u8> {
+    let mut model = load_with(path, set)?;
     apply_refine(path, &mut model, refine)?;
     Ok(model)
 }
@@ -89,22 +122,27 @@ fn apply_refine(path: &Path, model: &mut Model, refine: u32) -> Result<(), u8> {
     Ok(())
 }
 
-/// Parses a deck read once, refines it by `refine`, and names it: its path, the SHA-256
-/// of the very text parsed and the refinement (what a checkpoint is checked against).
-pub fn load_identified(path: &Path, refine: u32) -> Result<(Model, DeckIdentity), u8> {
+/// Parses a deck read once with the overrides `set`, refines it by `refine`, and names it:
+/// its path, the SHA-256 of the very text parsed, the overrides and the refinement (what a checkpoint is checked against).
+pub fn load_identified(
+    path: &Path,
+    set: &[(String, f64)],
+    refine: u32,
+) -> Result<(Model, DeckIdentity), u8> {
     let text = match std::fs::read(path).map(String::from_utf8) {
         Ok(Ok(t)) => t,
         // Unreadable or not UTF-8: the loader says so, with its diagnostics.
-        _ => return Err(load(path).err().unwrap_or(EXIT_BAD_INPUT)),
+        _ => return Err(load_with(path, set).err().unwrap_or(EXIT_BAD_INPUT)),
     };
     let name = path.display().to_string();
-    let mut model = deck::parse_deck(&text, &name).map_err(|errs| {
+    let mut model = deck::parse_deck_with(&text, &name, set).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })?;
     apply_refine(path, &mut model, refine)?;
     let id = DeckIdentity {
         refine: refine.max(1),
+        set: set.to_vec(),
         path: name,
         absolute: std::fs::canonicalize(path)
             .ok()
@@ -114,16 +152,28 @@ pub fn load_identified(path: &Path, refine: u32) -> Result<(Model, DeckIdentity)
     Ok((model, id))
 }
 
-/// `mecano-rs --check DECK [--refine k]`: parse, validate, refine, build the system, print
-/// the summary (with the nodes and elements generated).
-pub fn check(path: &Path, refine: u32) -> u8 {
-    let model = match load_refined(path, refine) {
+/// `mecano-rs --check DECK [--set n=v] [--refine k]`: parse, validate, refine, build the
+/// system, print the summary (with the nodes and elements generated) and the parameters
+/// with their values (`--set` overrides marked).
+pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
+    let model = match load_variant(path, set, refine) {
         Ok(m) => m,
         Err(code) => return code,
     };
     let mut out = std::io::stdout().lock();
     // A closed pipe (`mecano-rs --check deck | head`) is not an error of ours: ignore it.
     let _ = write!(out, "{}", model.summary());
+    if !model.parameters.is_empty() {
+        let _ = writeln!(out, "parameters:  {}", model.parameters.len());
+        for (name, v) in &model.parameters {
+            let mark = if set.iter().any(|(n, _)| n == name) {
+                "   (--set)"
+            } else {
+                ""
+            };
+            let _ = writeln!(out, "  {name} = {v:?}{mark}");
+        }
+    }
     match solver::prepare(&model) {
         Ok(integ) => {
             let _ = writeln!(
@@ -286,7 +336,7 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let (model, id) = match load_identified(path, opts.refine) {
+    let (model, id) = match load_identified(path, &opts.set, opts.refine) {
         Ok(m) => m,
         Err(code) => return code,
     };

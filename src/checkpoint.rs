@@ -35,7 +35,7 @@ const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 
 /// The deck a run belongs to.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DeckIdentity {
     /// The deck's path as the run was given it (what `summary.json` shows).
     pub path: String,
@@ -45,6 +45,8 @@ pub struct DeckIdentity {
     pub sha256: String,
     /// The `--refine` factor the run divided every beam by (1: the mesh as written).
     pub refine: u32,
+    /// The parameter overrides of the run (`--set`), in command-line order.
+    pub set: Vec<(String, f64)>,
 }
 
 /// The whole state of a run between two steps.
@@ -206,6 +208,7 @@ mod tests {
                 absolute: None,
                 sha256: sha256_hex(deck.as_bytes()),
                 refine: 1,
+                set: Vec::new(),
             },
             time: 0.0,
             step: 0,

@@ -21,3 +21,4 @@ pub mod rotation;
 pub mod scenes;
 pub mod solver;
 pub mod study;
+pub mod sweep;

@@ -56,6 +56,9 @@ struct Cli {
     /// deck's; the deck's nodes keep their numbers.
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     refine: u32,
+    /// Override a deck parameter (PARAMETERS section): `--set E=2.1e10`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = mecano::app::parse_set)]
+    set: Vec<(String, f64)>,
 }
 
 /// Subcommands: one variant each, the logic in the library.
@@ -81,6 +84,9 @@ restart is refused: no valid checkpoint, a complete run, or a deck whose text di
 1 one exceeds it; 2 bad input (a missing directory, file, node, element or column)."
     )]
     Compare(mecano::compare::CompareArgs),
+    /// Parameter study: run the cases of a plan (TOML) in parallel, or emit a Slurm job
+    /// array, and collect sweep.csv, statistics and figures.
+    Sweep(mecano::sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -90,11 +96,13 @@ fn main() -> ExitCode {
         (Some(Command::Study(args)), _) => mecano::study::run(args),
         (Some(Command::Resume(args)), _) => mecano::app::resume(args),
         (Some(Command::Compare(args)), _) => mecano::compare::run(args),
-        (None, Some(deck)) if cli.check => mecano::app::check(deck, cli.refine),
+        (Some(Command::Sweep(args)), _) => mecano::sweep::run(args),
+        (None, Some(deck)) if cli.check => mecano::app::check(deck, &cli.set, cli.refine),
         (None, Some(deck)) => mecano::app::run(
             deck,
             &mecano::app::RunOptions {
                 refine: cli.refine,
+                set: cli.set.clone(),
                 ..mecano::app::RunOptions::new(cli.out, cli.quiet, cli.checkpoint)
             },
         ),

@@ -98,7 +98,7 @@ pub fn resume(args: &ResumeArgs) -> u8 {
             .filter(|p| p.exists())
             .unwrap_or_else(|| PathBuf::from(&ck.deck.path))
     });
-    let (model, id) = match load_identified(&deck_path, ck.deck.refine) {
+    let (model, id) = match load_identified(&deck_path, &ck.deck.set, ck.deck.refine) {
         Ok(m) => m,
         Err(code) => {
             eprintln!(

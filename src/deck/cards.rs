@@ -1,7 +1,7 @@
 //! Stage 1 (syntax): logical lines → cards grouped by section.
 //!
 //! A line whose first token is a section keyword opens that section. `MATERIALS`,
-//! `SECTIONS`, `NODES`, `ELEMENTS`, `FUNCTIONS`, `LOADS` and `INITIAL` are block sections: their
+//! `SECTIONS`, `NODES`, `ELEMENTS`, `FUNCTIONS`, `LOADS`, `INITIAL` and `PARAMETERS` are block sections: their
 //! header stands alone and the following lines are their cards. `TITLE`, `ANALYSIS` and
 //! `OUTPUT` are one-line sections: the line is the card. `END` stops reading.
 
@@ -22,11 +22,12 @@ pub(crate) enum Section {
     Initial,
     Analysis,
     Output,
+    Parameters,
 }
 
 impl Section {
     /// Section keywords (the `END` terminator is handled apart).
-    const ALL: [(&'static str, Section); 10] = [
+    const ALL: [(&'static str, Section); 11] = [
         ("TITLE", Section::Title),
         ("MATERIALS", Section::Materials),
         ("SECTIONS", Section::Sections),
@@ -37,6 +38,7 @@ impl Section {
         ("INITIAL", Section::Initial),
         ("ANALYSIS", Section::Analysis),
         ("OUTPUT", Section::Output),
+        ("PARAMETERS", Section::Parameters),
     ];
 
     fn one_line(self) -> bool {
@@ -53,7 +55,7 @@ impl Section {
     }
 }
 
-const SECTION_LIST: &str = "TITLE, MATERIALS, SECTIONS, NODES, ELEMENTS, FUNCTIONS, LOADS, INITIAL, ANALYSIS, OUTPUT or END";
+const SECTION_LIST: &str = "TITLE, PARAMETERS, MATERIALS, SECTIONS, NODES, ELEMENTS, FUNCTIONS, LOADS, INITIAL, ANALYSIS, OUTPUT or END";
 
 /// One card: the tokens of a logical line, in the section it belongs to. For one-line
 /// sections the first token is the section keyword itself.
@@ -122,7 +124,12 @@ pub(crate) fn cards<'a>(lines: Vec<Line<'a>>, errors: &mut Vec<DeckError>) -> Ve
         }
         let is_word = first.number.is_none();
         match current {
-            Some(section) if !is_word || section.card_keywords().iter().any(|k| first.is_kw(k)) => {
+            // A PARAMETERS card starts with the parameter's name.
+            Some(section)
+                if !is_word
+                    || section == Section::Parameters
+                    || section.card_keywords().iter().any(|k| first.is_kw(k)) =>
+            {
                 out.push(Card {
                     section,
                     tokens: line.tokens,

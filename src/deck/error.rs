@@ -242,6 +242,68 @@ pub enum DeckErrorKind {
         /// The previous time as written.
         previous: String,
     },
+    /// An expression that does not parse.
+    #[error("bad expression `{text}`: expected {expected}, found {found}")]
+    BadExpression {
+        /// The whole field.
+        text: String,
+        /// What would have been accepted there.
+        expected: String,
+        /// What is there.
+        found: String,
+    },
+    /// `$name` without a parameter `name` (defined before, in a PARAMETERS section).
+    #[error(
+        "undefined parameter `{name}`: {known} (a parameter may only use the parameters defined before it)"
+    )]
+    UndefinedParameter {
+        /// The name after `$`.
+        name: String,
+        /// The parameters defined, as a sentence.
+        known: String,
+    },
+    /// A function that expressions do not have.
+    #[error(
+        "unknown function `{name}` in `{text}`: expected one of sqrt, sin, cos, exp, log, abs (or pi)"
+    )]
+    UnknownFunction {
+        /// The name.
+        name: String,
+        /// The whole field.
+        text: String,
+    },
+    /// An expression whose value (or part) is not a finite number.
+    #[error("expression `{text}`: {what} is not a finite number")]
+    ExpressionNotFinite {
+        /// The whole field.
+        text: String,
+        /// The part that overflowed or is undefined.
+        what: String,
+    },
+    /// A PARAMETERS card whose first field is not a valid name.
+    #[error(
+        "bad parameter name `{found}`: expected a letter or `_` followed by letters, digits or `_`"
+    )]
+    BadParameterName {
+        /// The field.
+        found: String,
+    },
+    /// A parameter defined twice.
+    #[error("parameter `{name}` defined again: already defined on line {first_line}")]
+    DuplicateParameter {
+        /// The name.
+        name: String,
+        /// Line of the first definition.
+        first_line: usize,
+    },
+    /// `--set name=value` (or a sweep plan) for a parameter the deck does not define.
+    #[error("cannot set parameter `{name}`: the deck does not define it ({known})")]
+    UnknownOverride {
+        /// The name given.
+        name: String,
+        /// The parameters defined, as a sentence.
+        known: String,
+    },
 }
 
 /// One mistake in a deck: what, and where (byte span in the source; `None` for file errors).
@@ -292,6 +354,12 @@ impl DeckError {
             | K::UJointNotPerpendicular { .. } => "mecano::deck::axis",
             K::OutOfRange { .. } => "mecano::deck::range",
             K::OddTable { .. } | K::DecreasingTime { .. } => "mecano::deck::table",
+            K::BadExpression { .. } | K::UnknownFunction { .. } => "mecano::deck::expression",
+            K::ExpressionNotFinite { .. } => "mecano::deck::expression_value",
+            K::UndefinedParameter { .. } | K::UnknownOverride { .. } => {
+                "mecano::deck::undefined_parameter"
+            }
+            K::BadParameterName { .. } | K::DuplicateParameter { .. } => "mecano::deck::parameter",
         }
     }
 
@@ -307,7 +375,10 @@ impl DeckError {
             K::Duplicate { .. } | K::RepeatedCard { .. } | K::RepeatedKeyword { .. } => {
                 "defined again here"
             }
-            K::Undefined { .. } => "undefined",
+            K::Undefined { .. } | K::UndefinedParameter { .. } => "undefined",
+            K::BadExpression { .. } | K::UnknownFunction { .. } => "unexpected here",
+            K::ExpressionNotFinite { .. } => "not finite",
+            K::DuplicateParameter { .. } => "defined again here",
             K::UnknownSection { .. }
             | K::UnknownKeyword { .. }
             | K::UnknownElementType { .. }

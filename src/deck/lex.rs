@@ -4,7 +4,9 @@
 //! * `!` or `#` starts a comment that runs to the end of the physical line.
 //! * A physical line whose last token is `&` continues on the next one; the `&` is dropped
 //!   and the two lines form one logical line.
-//! * A token is a maximal run of other characters. It is a *number* when the whole token
+//! * A token is a maximal run of other characters; blanks and commas inside parentheses do
+//!   not end it, so that `(2 * $zeta)` is one field (an expression, `expr.rs`). It is a
+//!   *number* when the whole token
 //!   matches `[+-]? (digits ['.' digits?] | '.' digits) ([eE] [+-]? digits)?`, otherwise a
 //!   *word* (keywords, malformed numbers such as `2.1e`, stray text — the builder decides).
 //!
@@ -14,7 +16,7 @@ use crate::model::Span;
 use nom::{
     IResult, Parser,
     branch::alt,
-    bytes::complete::{take_till1, take_while},
+    bytes::complete::take_while,
     character::complete::{char, digit0, digit1, one_of},
     combinator::{opt, value},
 };
@@ -26,8 +28,12 @@ pub(crate) struct Token<'a> {
     pub text: &'a str,
     /// Byte range in the source.
     pub span: Span,
-    /// The value when the token is lexically a number (may be infinite for `1e999`).
+    /// The value when the token is lexically a number (may be infinite for `1e999`), or
+    /// the value of the expression it holds once parameters are resolved (`params.rs`).
     pub number: Option<f64>,
+    /// Why the expression this token holds could not be evaluated (`params.rs`); reported
+    /// when a numeric field reads the token.
+    pub bad_expr: Option<Box<super::error::DeckError>>,
 }
 
 impl Token<'_> {
@@ -47,10 +53,6 @@ pub(crate) struct Line<'a> {
 
 fn is_sep(c: char) -> bool {
     c.is_whitespace() || c == ','
-}
-
-fn is_token_end(c: char) -> bool {
-    is_sep(c) || c == '!' || c == '#'
 }
 
 /// Checks the syntax of a number and returns what follows it. (Only the remainder's
@@ -88,7 +90,28 @@ fn next_token(input: &str) -> IResult<&str, Option<&str>> {
     if input.is_empty() || input.starts_with('!') || input.starts_with('#') {
         return Ok((input, None));
     }
-    let (rest, tok) = take_till1(is_token_end).parse(input)?;
+    // A maximal run of non-separators; inside parentheses only a comment ends it.
+    let mut depth = 0usize;
+    let mut end = input.len();
+    for (i, c) in input.char_indices() {
+        match c {
+            '!' | '#' => {
+                end = i;
+                break;
+            }
+            '(' => depth += 1,
+            ')' => depth = depth.saturating_sub(1),
+            c if depth == 0 && is_sep(c) => {
+                end = i;
+                break;
+            }
+            _ => {}
+        }
+    }
+    let tok = &input[..end];
+    // Trailing blanks of an unclosed parenthesis are not part of the token.
+    let tok = tok.trim_end_matches(is_sep);
+    let rest = &input[tok.len()..];
     Ok((rest, Some(tok)))
 }
 
@@ -102,6 +125,7 @@ fn line_tokens(line: &str, offset: usize) -> Vec<Token<'_>> {
             text: tok,
             span: Span::new(start, start + tok.len()),
             number: parse_number(tok),
+            bad_expr: None,
         });
         rest = r;
     }
@@ -183,6 +207,25 @@ mod tests {
         let t = &lines[1].tokens[2];
         assert_eq!(&src[t.span.start..t.span.end], "0");
         assert_eq!(t.span.start, 21);
+    }
+
+    #[test]
+    fn blanks_inside_parentheses_stay_in_the_field() {
+        let src = "C (2 * $z, 3) 4 (1 ! c\nX (a)(b c) d";
+        let lines = lex(src);
+        let texts: Vec<Vec<&str>> = lines
+            .iter()
+            .map(|l| l.tokens.iter().map(|t| t.text).collect())
+            .collect();
+        assert_eq!(
+            texts,
+            vec![
+                vec!["C", "(2 * $z, 3)", "4", "(1"],
+                vec!["X", "(a)(b c)", "d"]
+            ]
+        );
+        let t = &lines[0].tokens[1];
+        assert_eq!(&src[t.span.start..t.span.end], "(2 * $z, 3)");
     }
 
     #[test]

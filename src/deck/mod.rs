@@ -12,7 +12,9 @@
 mod build;
 mod cards;
 mod error;
+mod expr;
 mod lex;
+mod params;
 mod write;
 
 pub use error::{DeckError, DeckErrorKind, DeckErrors};
@@ -83,6 +85,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "one-line section: what to write and where",
     ),
     kw("END", "deck", "end of the deck: nothing after it is read"),
+    kw(
+        "PARAMETERS",
+        "deck",
+        "section header: `name value` cards; fields use them as `$name` in expressions",
+    ),
     // materials
     kw("E", "MATERIALS", "Young's modulus, N/m² (> 0)"),
     kw(
@@ -352,17 +359,45 @@ fn debug_check_keyword(kw: &str) {
 /// Parses a deck's text into a validated model, or returns every error found.
 /// `file_name` is only used in diagnostics. Never panics.
 pub fn parse_deck(source: &str, file_name: &str) -> Result<Model, DeckErrors> {
+    parse_deck_with(source, file_name, &[])
+}
+
+/// [`parse_deck`] with parameter overrides (`--set name=value`, a sweep's case): each
+/// `(name, value)` replaces the value of the deck's parameter `name` (see `grammar.md`,
+/// PARAMETERS); a name the deck does not define is an error.
+pub fn parse_deck_with(
+    source: &str,
+    file_name: &str,
+    overrides: &[(String, f64)],
+) -> Result<Model, DeckErrors> {
     let lines = lex::lex(source);
     let empty = lines.is_empty();
     let mut errors = Vec::new();
-    let cards = cards::cards(lines, &mut errors);
-    build::build_model(source, &cards, errors, empty)
+    let mut cards = cards::cards(lines, &mut errors);
+    let parameters = params::resolve(source, &mut cards, overrides, &mut errors);
+    build::build_model(source, &cards, errors, empty, parameters)
         .map_err(|errors| DeckErrors::new(source, file_name, errors))
+}
+
+/// Whether `name` is a valid parameter name (a letter or `_`, then letters, digits, `_`).
+pub fn is_parameter_name(name: &str) -> bool {
+    expr::is_name(name)
+}
+
+/// The value of `text` read as an expression of numbers (no parameters), e.g. the value
+/// of `--set h=1e-4/2`; `None` when it is not a finite number or expression.
+pub fn eval_constant(text: &str) -> Option<f64> {
+    expr::eval(text, &|_| None).ok()
 }
 
 /// Reads and parses a deck file. A missing or unreadable file, or one that is not UTF-8,
 /// gives a [`DeckErrors`] with a single error without span.
 pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
+    load_deck_with(path, &[])
+}
+
+/// [`load_deck`] with parameter overrides (see [`parse_deck_with`]).
+pub fn load_deck_with(path: &Path, overrides: &[(String, f64)]) -> Result<Model, DeckErrors> {
     let name = path.display().to_string();
     let file_error = |kind| DeckErrors::new("", &name, vec![DeckError { kind, span: None }]);
     let bytes = std::fs::read(path).map_err(|e| {
@@ -377,7 +412,7 @@ pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
             offset: e.utf8_error().valid_up_to(),
         })
     })?;
-    parse_deck(&text, &name)
+    parse_deck_with(&text, &name, overrides)
 }
 
 /// Sets every span in `model` to `Span::default()` (to compare models read from different

@@ -85,6 +85,13 @@ pub fn write_deck(model: &Model) -> String {
         .flat_map(|d| d.elements.iter().skip(1).copied())
         .collect();
     let _ = writeln!(s, "TITLE {}", model.title);
+    // Parameters with their values in force; every field below is written with its value.
+    if !model.parameters.is_empty() {
+        s.push_str("PARAMETERS\n");
+        for (name, v) in &model.parameters {
+            let _ = writeln!(s, "  {name} {v:?}");
+        }
+    }
     if !model.materials.is_empty() {
         s.push_str("MATERIALS\n");
         for m in model.materials.values() {

@@ -500,6 +500,9 @@ pub struct Model {
     /// beam's number, in deck order; their generated nodes and elements are in `nodes` and
     /// `elements` (see [`mesh`](self::Division) for the numbering).
     pub divisions: IndexMap<ElementId, Division>,
+    /// Deck parameters (`PARAMETERS`), name → value in force (the deck's value or an
+    /// override), in deck order. The fields that use them already hold their values.
+    pub parameters: IndexMap<String, f64>,
 }
 
 #[cfg(test)]

@@ -284,6 +284,16 @@ impl Writer {
         self.write_summary(None, None)
     }
 
+    /// Writes every accepted state (also the extra steps a contact event adds between the
+    /// instants k·h), as `OUTPUT EVERY 1` with adaptive steps does: for the sweeps, whose
+    /// quantities of interest must see the impacts (`crate::sweep::runner`).
+    pub fn every_accepted_step(&mut self) {
+        self.sampling = Sampling {
+            every: 1,
+            period: None,
+        };
+    }
+
     /// The output directory.
     pub fn dir(&self) -> &Path {
         &self.dir

@@ -47,9 +47,13 @@ impl<'t, 'a> Cursor<'t, 'a> {
         self.pos += 1;
     }
 
-    /// A finite number.
+    /// A finite number: written as a number, or an expression of parameters (its value was
+    /// computed by `params.rs`; an expression that failed reports its own error here).
     pub(super) fn number(&mut self, what: &str) -> R<(f64, Span, &'a str)> {
         let t = self.next(what)?;
+        if let Some(e) = &t.bad_expr {
+            return Err((**e).clone());
+        }
         match t.number {
             Some(v) if v.is_finite() => Ok((v, t.span, t.text)),
             Some(_) => Err(DeckError::new(
@@ -79,14 +83,27 @@ impl<'t, 'a> Cursor<'t, 'a> {
         let (v, span, text) = self.number(what)?;
         if ok(v) {
             Ok(v)
+        } else if super::super::expr::looks_like_expression(text) {
+            Err(out_of_range(what, &format!("{text} = {v:?}"), range, span))
         } else {
             Err(out_of_range(what, text, range, span))
         }
     }
 
-    /// A whole number in `0..=u32::MAX`.
+    /// A whole number in `0..=u32::MAX`, written as digits or as an expression of
+    /// parameters whose value is a whole number in that range.
     pub(super) fn uint(&mut self, what: &str) -> R<(u32, Span)> {
         let t = self.next(what)?;
+        if let Some(e) = &t.bad_expr {
+            return Err((**e).clone());
+        }
+        let whole = |v: &f64| v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(v);
+        if let Some(v) = t
+            .number
+            .filter(|v| super::super::expr::looks_like_expression(t.text) && whole(v))
+        {
+            return Ok((v as u32, t.span));
+        }
         let digits = t.text.strip_prefix('+').unwrap_or(t.text);
         let ok = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
         match digits.parse::<u32>() {
@@ -101,8 +118,11 @@ impl<'t, 'a> Cursor<'t, 'a> {
         }
     }
 
+    /// Whether the next token is a number or an expression (also one that failed: reading
+    /// it reports why).
     pub(super) fn next_is_number(&self) -> bool {
-        self.peek().is_some_and(|t| t.number.is_some())
+        self.peek()
+            .is_some_and(|t| t.number.is_some() || t.bad_expr.is_some())
     }
 
     pub(super) fn vec3(&mut self, what: &str) -> R<(Vector3<f64>, Span, [&'a str; 3])> {

@@ -121,6 +121,7 @@ pub(crate) fn build_model(
     cards: &[Card<'_>],
     errors: Vec<DeckError>,
     empty: bool,
+    parameters: IndexMap<String, f64>,
 ) -> Result<Model, Vec<DeckError>> {
     let mut b = Builder {
         src,
@@ -215,6 +216,7 @@ pub(crate) fn build_model(
         analysis,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
+        parameters,
     };
     // Generated numbers start past every user number: divide once all are known.
     let mut numbering = crate::model::Numbering::after(&model);

@@ -1,0 +1,333 @@
+//! Running cases: one case in this process ([`run_case`], what a Slurm task runs), or all
+//! pending cases of a plan on the local cores ([`run_local`]).
+//!
+//! A case runs the plan's deck with the case's parameter values (`--set`) into its own
+//! directory, computes the quantities of interest from what the run wrote, and records it
+//! all in `case.json`, written last (atomically): a case directory with a `case.json` of
+//! the same parameter values and deck text (hash) is *finished* — completed or failed with its diagnosis — and
+//! is skipped when the plan runs again; a directory without one was interrupted and is run
+//! again ([`restart_incomplete_case`]). A failed case (Newton divergence, non-finite
+//! values, values the deck rejects) is recorded and the others go on.
+
+use super::SweepError;
+use super::plan::Plan;
+use crate::app;
+use serde::{Deserialize, Serialize};
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// How a case ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The run reached its end.
+    Ok,
+    /// The run stopped (no convergence, non-finite state): its diagnosis is recorded.
+    Failed,
+    /// The deck rejected the case's values (e.g. a parameter out of a field's range).
+    BadInput,
+    /// A quantity could not be computed (the deck does not write the file or column).
+    QuantityError,
+    /// Not run yet (only in sweep.csv).
+    Missing,
+}
+
+impl Status {
+    /// The word written in sweep.csv.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "failed",
+            Status::BadInput => "bad_input",
+            Status::QuantityError => "quantity_error",
+            Status::Missing => "missing",
+        }
+    }
+}
+
+/// What `case.json` records.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseRecord {
+    /// The case's index in the plan.
+    pub case: usize,
+    /// Parameter values, in plan order.
+    pub values: Vec<f64>,
+    /// How it ended.
+    pub status: Status,
+    /// Why it failed (empty when ok).
+    pub diagnosis: String,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Time reached, s.
+    pub time: f64,
+    /// CPU (wall) seconds of the run (a timing).
+    pub cpu_s: f64,
+    /// Quantities of interest, in plan order (`None`: does not exist for this case).
+    pub quantities: Vec<Option<f64>>,
+    /// Their names (a plan whose quantities changed recomputes them from the case's files).
+    #[serde(default)]
+    pub quantity_names: Vec<String>,
+    /// The hash of the deck's text it ran with ([`super::plan::fnv1a`]).
+    #[serde(default)]
+    pub deck_hash: String,
+}
+
+/// The record of finished case `i`, if its directory holds one for its parameter values.
+/// When the plan's quantities differ from those recorded, they are computed again from
+/// the case's files (no rerun) and the record rewritten.
+pub fn finished(plan: &Plan, i: usize) -> Option<CaseRecord> {
+    let dir = plan.case_dir(i);
+    let text = std::fs::read_to_string(dir.join("case.json")).ok()?;
+    let mut rec: CaseRecord = serde_json::from_str(&text).ok()?;
+    if rec.values != plan.cases[i] || rec.deck_hash != plan.deck_hash {
+        return None;
+    }
+    if rec.quantity_names != names(plan) {
+        quantify(plan, &dir, &mut rec);
+        write_record(&dir, &rec).ok()?;
+    }
+    Some(rec)
+}
+
+fn names(plan: &Plan) -> Vec<String> {
+    plan.quantities.iter().map(|q| q.name.clone()).collect()
+}
+
+/// Computes the plan's quantities from the case's files (runs that ended ok or failed).
+fn quantify(plan: &Plan, dir: &Path, rec: &mut CaseRecord) {
+    rec.quantity_names = names(plan);
+    rec.quantities = vec![None; plan.quantities.len()];
+    if rec.status == Status::QuantityError {
+        rec.status = Status::Ok;
+        rec.diagnosis.clear();
+    }
+    if !matches!(rec.status, Status::Ok | Status::Failed) {
+        return;
+    }
+    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    for (k, q) in plan.quantities.iter().enumerate() {
+        match q.eval(dir, &summary) {
+            Ok(v) => rec.quantities[k] = v,
+            Err(msg) => {
+                if rec.status == Status::Ok {
+                    rec.status = Status::QuantityError;
+                    rec.diagnosis = one_line(&msg);
+                }
+            }
+        }
+    }
+}
+
+fn write_record(dir: &Path, rec: &CaseRecord) -> std::io::Result<()> {
+    let text = serde_json::to_string_pretty(rec).unwrap_or_default();
+    let tmp = dir.join("case.json.tmp");
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, dir.join("case.json"))
+}
+
+/// Runs case `i` unless it is finished; returns its record.
+pub fn run_case(plan: &Plan, i: usize) -> Result<CaseRecord, SweepError> {
+    let dir = plan.case_dir(i);
+    if let Some(rec) = finished(plan, i) {
+        return Ok(rec);
+    }
+    if dir.exists() {
+        return restart_incomplete_case(plan, i, &dir);
+    }
+    run_fresh(plan, i, &dir)
+}
+
+/// **Restart point (issue 19).** A case directory without a finished `case.json` was
+/// interrupted (killed, Slurm's time limit, a plan changed since): it is run again here
+/// from scratch, its old files removed. When `mecano-rs resume OUTDIR` (checkpoints) is
+/// merged, this is the one place to switch to resuming from the case's checkpoint.
+pub fn restart_incomplete_case(
+    plan: &Plan,
+    i: usize,
+    dir: &Path,
+) -> Result<CaseRecord, SweepError> {
+    std::fs::remove_dir_all(dir).map_err(|e| SweepError::Io {
+        path: dir.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    run_fresh(plan, i, dir)
+}
+
+fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError> {
+    let io = |e: std::io::Error| SweepError::Io {
+        path: dir.to_path_buf(),
+        reason: e.to_string(),
+    };
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let values = plan.cases[i].clone();
+    let mut rec = CaseRecord {
+        case: i,
+        values,
+        status: Status::Ok,
+        diagnosis: String::new(),
+        steps: 0,
+        time: 0.0,
+        cpu_s: 0.0,
+        quantities: vec![None; plan.quantities.len()],
+        quantity_names: names(plan),
+        deck_hash: plan.deck_hash.clone(),
+    };
+    let deck_name = plan.deck.display().to_string();
+    match crate::deck::load_deck_with(&plan.deck, &plan.overrides(i)) {
+        Err(errs) => {
+            rec.status = Status::BadInput;
+            rec.diagnosis = one_line(&deck_errors_text(&errs));
+        }
+        Ok(model) => match run_model(&model, &deck_name, dir) {
+            Err((_, msg)) => {
+                rec.status = Status::BadInput;
+                rec.diagnosis = one_line(&msg);
+            }
+            Ok(report) => {
+                rec.steps = report.stats.steps;
+                rec.time = report.time;
+                rec.cpu_s = report.stats.cpu_seconds;
+                if let Some(f) = &report.failure {
+                    rec.status = Status::Failed;
+                    rec.diagnosis = one_line(&f.to_string());
+                }
+                quantify(plan, dir, &mut rec);
+            }
+        },
+    }
+    write_record(dir, &rec).map_err(io)?;
+    Ok(rec)
+}
+
+/// [`app::run_model`] for a case: no progress bar, no VTK, and, when the deck writes every
+/// step (`OUTPUT EVERY 1`, the default), *every accepted step*, also the extra steps of
+/// contact events that a plain run leaves out to keep its rows on the instants k·h: the
+/// quantities of interest must see the impacts (with h = 5e-5 s on the pendulum the whole
+/// first contact falls between two grid instants). With `EVERY n > 1` the deck's sampling
+/// is kept (fewer rows for large sweeps; the quantities see those rows only).
+fn run_model(
+    model: &crate::model::Model,
+    deck_name: &str,
+    dir: &Path,
+) -> Result<crate::solver::RunReport, (u8, String)> {
+    use crate::solver;
+    let mut integ = solver::prepare(model).map_err(|e| (app::EXIT_BAD_INPUT, e.to_string()))?;
+    let io = |e: std::io::Error| (app::EXIT_FAILED, format!("{}: {e}", dir.display()));
+    let mut writer =
+        crate::output::Writer::create(dir, deck_name, model, &integ.sys).map_err(io)?;
+    if model.output.every <= 1 {
+        writer.every_accepted_step();
+    }
+    let mut report = match solver::run_prepared(model, &mut integ, &mut writer) {
+        Ok(r) => r,
+        Err(solver::RunError::Output(e)) => solver::RunReport {
+            stats: integ.stats,
+            time: integ.t,
+            interrupted: None,
+            failure: Some(solver::Failure {
+                time: integ.t,
+                step: 0.0,
+                reason: solver::FailureReason::NotFinite,
+                residual_history: vec![],
+                worst: format!("output: {e}"),
+                worst_value: 0.0,
+                reference_force: 0.0,
+                diagnoses: Box::default(),
+            }),
+        },
+        Err(e) => return Err((app::EXIT_BAD_INPUT, e.to_string())),
+    };
+    report.stats = integ.stats;
+    writer.finish(&integ, &report).map_err(io)?;
+    Ok(report)
+}
+
+fn deck_errors_text(errs: &crate::deck::DeckErrors) -> String {
+    let mut parts = Vec::new();
+    for (k, e) in errs.errors().iter().enumerate() {
+        match errs.line_col(k) {
+            Some((l, c)) => parts.push(format!("{}:{l}:{c}: {e}", errs.file_name())),
+            None => parts.push(format!("{}: {e}", errs.file_name())),
+        }
+    }
+    parts.join("; ")
+}
+
+/// The first line of a message, without the separators of sweep.csv's cells.
+fn one_line(s: &str) -> String {
+    s.lines().next().unwrap_or("").trim().to_string()
+}
+
+/// Runs the cases `which` (indices) of the plan on `jobs` threads, each case in-process,
+/// with a progress bar over cases (on a terminal, unless `quiet`). Returns how many were
+/// run and how many of those did not end `ok`.
+pub fn run_local(
+    plan: &Plan,
+    which: &[usize],
+    jobs: usize,
+    quiet: bool,
+) -> Result<(usize, usize), SweepError> {
+    let pending: Vec<usize> = which
+        .iter()
+        .copied()
+        .filter(|&i| finished(plan, i).is_none())
+        .collect();
+    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+        let pb = indicatif::ProgressBar::new(pending.len() as u64);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} cases, {msg} [{elapsed}, ~{eta} left]",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        pb
+    });
+    let next = AtomicUsize::new(0);
+    let not_ok = AtomicUsize::new(0);
+    let first_error: std::sync::Mutex<Option<SweepError>> = std::sync::Mutex::new(None);
+    let jobs = jobs.clamp(1, pending.len().max(1));
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            s.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&i) = pending.get(k) else { break };
+                    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        run_case(plan, i)
+                    }));
+                    match r {
+                        Ok(Ok(rec)) => {
+                            if rec.status != Status::Ok {
+                                not_ok.fetch_add(1, Ordering::Relaxed);
+                            }
+                        }
+                        Ok(Err(e)) => {
+                            not_ok.fetch_add(1, Ordering::Relaxed);
+                            if let Ok(mut g) = first_error.lock() {
+                                g.get_or_insert(e);
+                            }
+                        }
+                        Err(_) => {
+                            not_ok.fetch_add(1, Ordering::Relaxed);
+                        }
+                    }
+                    if let Some(pb) = &bar {
+                        pb.inc(1);
+                        pb.set_message(format!("{} not ok", not_ok.load(Ordering::Relaxed)));
+                    }
+                }
+            });
+        }
+    });
+    if let Some(pb) = bar {
+        pb.finish_and_clear();
+    }
+    if let Some(e) = first_error.into_inner().ok().flatten() {
+        return Err(e);
+    }
+    Ok((pending.len(), not_ok.into_inner()))
+}
