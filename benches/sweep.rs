@@ -42,7 +42,7 @@ fn case_overhead(c: &mut Criterion) {
     g.bench_function("case_overhead_run_case", |b| {
         b.iter(|| {
             let _ = std::fs::remove_dir_all(plan.case_dir(4));
-            runner::run_case(&plan, 4).expect("case")
+            runner::run_case(&plan, 4, &mecano::interrupt::Interrupts::none()).expect("case")
         })
     });
     g.finish();

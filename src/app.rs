@@ -8,7 +8,7 @@
 mod resume;
 mod session;
 
-pub use resume::{ResumeArgs, resume};
+pub use resume::{ResumeArgs, resume, resume_run};
 pub use session::CheckpointPlan;
 
 use crate::checkpoint::{self, DeckIdentity};
@@ -140,16 +140,22 @@ pub fn load_identified(
         EXIT_BAD_INPUT
     })?;
     apply_refine(path, &mut model, refine)?;
-    let id = DeckIdentity {
-        refine: refine.max(1),
-        set: set.to_vec(),
-        path: name,
+    let id = deck_identity(path, &text, set, refine);
+    Ok((model, id))
+}
+
+/// The identity of a run's deck, as a checkpoint records it: the path as given and its
+/// absolute form, the SHA-256 of the text parsed, the overrides and the refinement.
+pub fn deck_identity(path: &Path, text: &str, set: &[(String, f64)], refine: u32) -> DeckIdentity {
+    DeckIdentity {
+        path: path.display().to_string(),
         absolute: std::fs::canonicalize(path)
             .ok()
             .map(|p| p.display().to_string()),
         sha256: checkpoint::sha256_hex(text.as_bytes()),
-    };
-    Ok((model, id))
+        refine: refine.max(1),
+        set: set.to_vec(),
+    }
 }
 
 /// `mecano-rs --check DECK [--set n=v] [--refine k]`: parse, validate, refine, build the
@@ -214,7 +220,33 @@ pub fn run_model(
     dir: &Path,
     quiet: bool,
 ) -> Result<RunReport, (u8, String)> {
-    start_session(model, deck_name, dir, quiet, None, Interrupts::none())
+    start_session(
+        model,
+        deck_name,
+        dir,
+        quiet,
+        None,
+        Interrupts::none(),
+        false,
+    )
+}
+
+/// Runs `model`, read from the deck `deck`, into `dir` as `mecano-rs DECK` does —
+/// checkpoints every `every` seconds of wall time (0: only at a stop), a clean stop at the
+/// end of a step when `interrupts` asks — and returns the report instead of printing it:
+/// the library's entry point for a sweep's case, which [`resume_run`] continues after a
+/// stop. `every_step`: write every accepted step ([`Writer::every_accepted_step`]).
+pub fn run_checkpointed(
+    model: &Model,
+    deck: DeckIdentity,
+    dir: &Path,
+    every: f64,
+    every_step: bool,
+    interrupts: Interrupts,
+) -> Result<RunReport, (u8, String)> {
+    let name = deck.path.clone();
+    let plan = CheckpointPlan::new(every, deck);
+    start_session(model, &name, dir, true, Some(plan), interrupts, every_step)
 }
 
 /// Prepares the integrator and the writers of a fresh run, and executes it.
@@ -225,11 +257,15 @@ fn start_session(
     quiet: bool,
     plan: Option<CheckpointPlan>,
     interrupts: Interrupts,
+    every_step: bool,
 ) -> Result<RunReport, (u8, String)> {
     let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
     let io_err = |e: std::io::Error| (EXIT_FAILED, format!("{}: {e}", dir.display()));
     let mut writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(io_err)?;
     writer.refine = plan.as_ref().map_or(1, |p| p.deck.refine);
+    if every_step {
+        writer.every_accepted_step();
+    }
     // A checkpoint of an earlier run in this directory belongs to files just replaced.
     for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
         match std::fs::remove_file(dir.join(name)) {
@@ -311,7 +347,8 @@ fn report_outcome(what: &str, dir: &Path, quiet: bool, report: &RunReport) -> u8
 }
 
 /// Installs the SIGINT/SIGTERM handlers (a failure to do so only costs clean stops).
-fn interrupts() -> Interrupts {
+/// The handlers of SIGINT and SIGTERM, installed (a warning when they cannot be).
+pub fn interrupts() -> Interrupts {
     Interrupts::install().unwrap_or_else(|e| {
         eprintln!("warning: cannot handle SIGINT/SIGTERM ({e}): a stop will not be clean");
         Interrupts::none()
@@ -346,7 +383,15 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         .unwrap_or_else(|| default_out_dir(path, &model));
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);
-    match start_session(&model, &what, &dir, opts.quiet, Some(plan), interrupts()) {
+    match start_session(
+        &model,
+        &what,
+        &dir,
+        opts.quiet,
+        Some(plan),
+        interrupts(),
+        false,
+    ) {
         Ok(report) => report_outcome(&what, &dir, opts.quiet, &report),
         Err((code, msg)) => {
             eprintln!("error: {what}: {msg}");

@@ -465,3 +465,50 @@ fn a_paraview_series_is_resumed_too() {
         assert!(tb[k] == *v, "{k} differs");
     }
 }
+
+/// A run's `--set` overrides and `--refine` factor are part of its identity: `resume`
+/// rebuilds the very model the run had (refined, with the overridden values) and the files
+/// come out byte for byte as those of the same run never stopped.
+#[test]
+fn resume_rebuilds_a_refined_run_with_its_parameter_overrides() {
+    let base = tmp("variant");
+    let (clean, stopped) = (base.join("clean"), base.join("stopped"));
+    let args = |d: &Path| -> Vec<String> {
+        [
+            "decks/pendulum_sweep.dat",
+            "-q",
+            "--set",
+            "T=0.08",
+            "--set",
+            "E=2.1e10",
+            "--refine",
+            "2",
+            "-o",
+            d.to_str().unwrap(),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let a = args(&clean);
+    let o = run(&a.iter().map(String::as_str).collect::<Vec<_>>(), None);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let a = args(&stopped);
+    let o = run(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        Some("signal:INT:300"),
+    );
+    assert_eq!(o.status.code(), Some(130), "{}", text(&o));
+    let o = resume(&stopped);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let files = csv_files(&clean);
+    assert!(files.len() >= 3, "{files:?}");
+    for f in files {
+        assert_eq!(
+            std::fs::read(clean.join(&f)).unwrap(),
+            std::fs::read(stopped.join(&f)).unwrap(),
+            "{f} differs"
+        );
+    }
+    assert_eq!(summary(&stopped)["refine"], 2);
+    let _ = std::fs::remove_dir_all(&base);
+}

@@ -426,3 +426,56 @@ fn a_diverging_case_is_recorded_with_its_diagnosis() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A sweep stopped by SIGINT (through the run's test hook `MECANO_FAILPOINT`, which raises
+/// the real signal at a known step) exits 130 leaving the case under way with a checkpoint
+/// and no `case.json`; running the plan again goes on from that checkpoint, and every
+/// history file of every case is byte for byte that of a sweep never stopped.
+#[test]
+fn an_interrupted_sweep_goes_on_from_its_checkpoints() {
+    let clean = tmp("clean");
+    let stopped = tmp("stopped");
+    let (c, s) = (
+        clean.to_str().expect("utf-8"),
+        stopped.to_str().expect("utf-8"),
+    );
+    let r = run(&["sweep", "sweeps/bounce.toml", "-o", c, "-q"]);
+    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    let r = Command::new(BIN)
+        .args(["sweep", "sweeps/bounce.toml", "-o", s, "-q", "--jobs", "1"])
+        .env("MECANO_FAILPOINT", "signal:INT:20")
+        .current_dir(root())
+        .output()
+        .expect("binary runs");
+    assert_eq!(r.status.code(), Some(130), "{}", text(&r));
+    let case0 = stopped.join("cases/0000");
+    assert!(case0.join("checkpoint.bin").is_file() && !case0.join("case.json").exists());
+    assert!(
+        !stopped.join("cases/0001").exists(),
+        "no case starts after the stop"
+    );
+    let r = run(&["sweep", "sweeps/bounce.toml", "-o", s, "-q"]);
+    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    let summary = std::fs::read_to_string(case0.join("summary.json")).expect("summary");
+    assert!(
+        summary.contains("\"resumes\""),
+        "case 0 was resumed: {summary}"
+    );
+    for case in 0..6 {
+        let name = format!("cases/{case:04}");
+        for entry in std::fs::read_dir(clean.join(&name)).expect("case dir") {
+            let path = entry.expect("entry").path();
+            if path.extension().is_some_and(|e| e == "csv") {
+                let other = stopped.join(&name).join(path.file_name().expect("name"));
+                assert_eq!(
+                    std::fs::read(&path).expect("read"),
+                    std::fs::read(&other).expect("read"),
+                    "{} differs",
+                    other.display()
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&clean);
+    let _ = std::fs::remove_dir_all(&stopped);
+}

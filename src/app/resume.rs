@@ -13,9 +13,10 @@ use super::{
     load_identified, report_outcome,
 };
 use crate::checkpoint;
+use crate::interrupt::Interrupts;
 use crate::output::Writer;
 use crate::output::vtk::VtkWriter;
-use crate::solver;
+use crate::solver::{self, RunReport};
 use std::path::{Path, PathBuf};
 
 /// `mecano-rs resume …`
@@ -35,26 +36,52 @@ pub struct ResumeArgs {
 }
 
 /// Why a restart is refused (exit code 2).
-fn refuse(dir: &Path, msg: impl std::fmt::Display) -> u8 {
-    eprintln!("error: resume {}: {msg}", dir.display());
-    EXIT_BAD_INPUT
+fn refuse(msg: impl std::fmt::Display) -> (u8, String) {
+    (EXIT_BAD_INPUT, msg.to_string())
 }
 
 /// `mecano-rs resume OUTDIR`; returns the exit code.
 pub fn resume(args: &ResumeArgs) -> u8 {
-    let dir = args.dir.as_path();
     let every = match checkpoint_seconds(args.checkpoint) {
         Ok(s) => s,
         Err(code) => return code,
     };
+    let what = format!("resume {}", args.dir.display());
+    match resume_run(
+        &args.dir,
+        args.deck.as_deref(),
+        every,
+        args.quiet,
+        interrupts(),
+    ) {
+        Ok(report) => report_outcome(&what, &args.dir, args.quiet, &report),
+        Err((code, msg)) => {
+            eprintln!("error: {what}: {msg}");
+            code
+        }
+    }
+}
+
+/// Goes on from the last checkpoint in `dir` (the deck read from where the run found it,
+/// or `deck`), writing checkpoints every `every` seconds of wall time (0: only at an
+/// interruption), until the end, a failure or a stop that `interrupts` asks for. The
+/// library's entry point of `mecano-rs resume` (a sweep's interrupted case goes on here).
+/// A refusal is exit code 2 with its reason.
+pub fn resume_run(
+    dir: &Path,
+    deck: Option<&Path>,
+    every: f64,
+    quiet: bool,
+    interrupts: Interrupts,
+) -> Result<RunReport, (u8, String)> {
     if !dir.is_dir() {
-        return refuse(dir, "no such output directory");
+        return Err(refuse("no such output directory"));
     }
     let summary: Option<serde_json::Value> = match std::fs::read_to_string(dir.join("summary.json"))
     {
         Ok(t) => match serde_json::from_str(&t) {
             Ok(v) => Some(v),
-            Err(e) => return refuse(dir, format!("summary.json is not valid JSON ({e})")),
+            Err(e) => return Err(refuse(format!("summary.json is not valid JSON ({e})"))),
         },
         Err(_) => None,
     };
@@ -62,10 +89,9 @@ pub fn resume(args: &ResumeArgs) -> u8 {
         .as_ref()
         .is_some_and(|s| s["complete"] == serde_json::Value::Bool(true))
     {
-        return refuse(
-            dir,
+        return Err(refuse(
             "the run is complete (summary.json: \"complete\": true): nothing to resume",
-        );
+        ));
     }
     if let Some(f) = summary
         .as_ref()
@@ -73,24 +99,21 @@ pub fn resume(args: &ResumeArgs) -> u8 {
         .filter(|f| f.is_object())
         && !dir.join(checkpoint::FILE_NAME).exists()
     {
-        return refuse(
-            dir,
-            format!(
-                "the run failed ({}); a restart would fail again at the same step: change the deck and run it again",
-                f["message"]
-                    .as_str()
-                    .unwrap_or("see summary.json")
-                    .lines()
-                    .next()
-                    .unwrap_or("")
-            ),
-        );
+        return Err(refuse(format!(
+            "the run failed ({}); a restart would fail again at the same step: change the deck and run it again",
+            f["message"]
+                .as_str()
+                .unwrap_or("see summary.json")
+                .lines()
+                .next()
+                .unwrap_or("")
+        )));
     }
     let ck = match checkpoint::read(dir) {
         Ok(c) => c,
-        Err(e) => return refuse(dir, e),
+        Err(e) => return Err(refuse(e)),
     };
-    let deck_path = args.deck.clone().unwrap_or_else(|| {
+    let deck_path = deck.map(Path::to_path_buf).unwrap_or_else(|| {
         ck.deck
             .absolute
             .as_ref()
@@ -101,35 +124,33 @@ pub fn resume(args: &ResumeArgs) -> u8 {
     let (model, id) = match load_identified(&deck_path, &ck.deck.set, ck.deck.refine) {
         Ok(m) => m,
         Err(code) => {
-            eprintln!(
-                "error: resume {}: the run's deck {} cannot be read (see above); give its place with --deck",
-                dir.display(),
-                deck_path.display()
-            );
-            return code;
+            return Err((
+                code,
+                format!(
+                    "the run's deck {} cannot be read (see above); give its place with --deck",
+                    deck_path.display()
+                ),
+            ));
         }
     };
     if id.sha256 != ck.deck.sha256 {
-        return refuse(
-            dir,
-            format!(
-                "the deck {} is not the one this run's checkpoint belongs to: its text differs (SHA-256 {} now, {} at the run); a changed deck is a new run",
-                deck_path.display(),
-                &id.sha256[..16],
-                &ck.deck.sha256[..16.min(ck.deck.sha256.len())]
-            ),
-        );
+        return Err(refuse(format!(
+            "the deck {} is not the one this run's checkpoint belongs to: its text differs (SHA-256 {} now, {} at the run); a changed deck is a new run",
+            deck_path.display(),
+            &id.sha256[..16],
+            &ck.deck.sha256[..16.min(ck.deck.sha256.len())]
+        )));
     }
     let mut integ = match solver::prepare(&model) {
         Ok(i) => i,
-        Err(e) => return refuse(dir, e),
+        Err(e) => return Err(refuse(e)),
     };
     let (time, step) = (ck.time, ck.step);
     if let Err(e) = integ.restore_state(ck.integrator) {
-        return refuse(dir, format!("the checkpoint does not fit the deck: {e}"));
+        return Err(refuse(format!("the checkpoint does not fit the deck: {e}")));
     }
     if integ.t.to_bits() != time.to_bits() || integ.stats.steps != step {
-        return refuse(dir, "the checkpoint is inconsistent (time or step)");
+        return Err(refuse("the checkpoint is inconsistent (time or step)"));
     }
     // What the restart cuts: rows written after the checkpoint.
     let cut: u64 = ck
@@ -144,10 +165,9 @@ pub fn resume(args: &ResumeArgs) -> u8 {
     let mut writer = match Writer::resume(dir, &ck.deck.path, &model, &integ.sys, &ck.writer) {
         Ok(w) => w,
         Err(e) => {
-            return refuse(
-                dir,
-                format!("the history files do not fit the checkpoint: {e}"),
-            );
+            return Err(refuse(format!(
+                "the history files do not fit the checkpoint: {e}"
+            )));
         }
     };
     writer.refine = ck.deck.refine;
@@ -155,16 +175,12 @@ pub fn resume(args: &ResumeArgs) -> u8 {
         (false, _) => None,
         (true, Some(state)) => match VtkWriter::resume(dir, &model, &integ.sys, state) {
             Ok(v) => Some(v),
-            Err(e) => {
-                eprintln!("error: resume {}: {e}", dir.display());
-                return EXIT_FAILED;
-            }
+            Err(e) => return Err((EXIT_FAILED, e.to_string())),
         },
         (true, None) => {
-            return refuse(
-                dir,
+            return Err(refuse(
                 "the checkpoint has no VTK series, the deck asks for one",
-            );
+            ));
         }
     };
     // The record of the stops and restarts, carried from one restart to the next.
@@ -188,11 +204,9 @@ pub fn resume(args: &ResumeArgs) -> u8 {
         .notes
         .insert("resumes".into(), serde_json::Value::Array(resumes));
     if let Err(e) = writer.write_notes() {
-        eprintln!("error: resume {}: {e}", dir.display());
-        return EXIT_FAILED;
+        return Err((EXIT_FAILED, e.to_string()));
     }
     let what = format!("resume {}", dir.display());
-    let quiet = args.quiet;
     if !quiet {
         eprintln!(
             "{what}: going on from t = {time:.6e} s (step {step}) of {}; {cut} bytes written after the checkpoint cut",
@@ -207,14 +221,8 @@ pub fn resume(args: &ResumeArgs) -> u8 {
         writer,
         vtk,
         plan: Some(CheckpointPlan::new(every, ck.deck)),
-        interrupts: interrupts(),
+        interrupts,
         resume: Some(ck.control),
     };
-    match session.execute() {
-        Ok(report) => report_outcome(&what, dir, quiet, &report),
-        Err((code, msg)) => {
-            eprintln!("error: {what}: {msg}");
-            code
-        }
-    }
+    session.execute()
 }

@@ -42,7 +42,7 @@ pub type ProgressFn = Box<dyn FnMut(f64, f64, &Stats)>;
 /// Which accepted states `OUTPUT … EVERY n` writes: with fixed steps, the states at the
 /// instants `k n h` (steps land back on that grid after contact events, which add steps of
 /// their own, so a history keeps regular instants); with adaptive steps, every n-th state.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Sampling {
     every: u64,
     /// `n h` for fixed steps.
@@ -114,6 +114,8 @@ pub struct WriterState {
     energy_scale: f64,
     max_balance: f64,
     last_row: Option<u64>,
+    /// Which states the run writes (a sweep's case writes every accepted step).
+    sampling: Option<Sampling>,
 }
 
 /// The files a model's OUTPUT asks for: (dense node, file, header), (dense element,
@@ -222,6 +224,9 @@ impl Writer {
         w.energy_scale = state.energy_scale;
         w.max_balance = state.max_balance;
         w.last_row = state.last_row;
+        if let Some(sampling) = state.sampling {
+            w.sampling = sampling;
+        }
         Ok(w)
     }
 
@@ -276,6 +281,7 @@ impl Writer {
             energy_scale: self.energy_scale,
             max_balance: self.max_balance,
             last_row: self.last_row,
+            sampling: Some(self.sampling),
         })
     }
 

@@ -43,6 +43,12 @@ pub enum SweepError {
         /// The operating system's reason.
         reason: String,
     },
+    /// SIGINT or SIGTERM stopped the sweep: the cases under way wrote a checkpoint and
+    /// go on from it when the plan runs again.
+    #[error(
+        "interrupted: the cases under way were checkpointed; run the same command again to go on"
+    )]
+    Interrupted,
     /// `--case` names cases the plan does not have, or is malformed.
     #[error("--case {spec}: {msg}")]
     CaseSpec {
@@ -144,7 +150,8 @@ fn fmt_values(plan: &Plan, i: usize) -> String {
 }
 
 /// `mecano-rs sweep`: returns the exit code (0 every case finished — completed or failed
-/// with its diagnosis —; 1 cases could not be run or files not written; 2 bad plan or deck).
+/// with its diagnosis —; 1 cases could not be run or files not written; 2 bad plan or deck;
+/// 130 interrupted by SIGINT/SIGTERM, the cases under way checkpointed).
 pub fn run(args: &SweepArgs) -> u8 {
     let plan = match Plan::load(&args.plan, args.out.as_deref()) {
         Ok(p) => p,
@@ -209,7 +216,7 @@ pub fn run(args: &SweepArgs) -> u8 {
         };
         let jobs = args.jobs.unwrap_or(default_jobs).max(1);
         let start = std::time::Instant::now();
-        match runner::run_local(&plan, &which, jobs, args.quiet) {
+        match runner::run_local(&plan, &which, jobs, args.quiet, &crate::app::interrupts()) {
             Ok((ran, not_ok)) => {
                 if !args.quiet {
                     let _ = writeln!(
@@ -220,6 +227,10 @@ pub fn run(args: &SweepArgs) -> u8 {
                         start.elapsed().as_secs_f64()
                     );
                 }
+            }
+            Err(SweepError::Interrupted) => {
+                eprintln!("{}: {}", args.plan.display(), SweepError::Interrupted);
+                return crate::app::EXIT_INTERRUPTED;
             }
             Err(e) => {
                 eprintln!("error: {e}");

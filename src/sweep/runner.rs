@@ -12,6 +12,7 @@
 use super::SweepError;
 use super::plan::Plan;
 use crate::app;
+use crate::interrupt::Interrupts;
 use serde::{Deserialize, Serialize};
 use std::io::IsTerminal;
 use std::path::Path;
@@ -68,7 +69,7 @@ pub struct CaseRecord {
     /// Their names (a plan whose quantities changed recomputes them from the case's files).
     #[serde(default)]
     pub quantity_names: Vec<String>,
-    /// The hash of the deck's text it ran with ([`super::plan::fnv1a`]).
+    /// The hash of the deck's text it ran with (SHA-256, as a checkpoint names its deck).
     #[serde(default)]
     pub deck_hash: String,
 }
@@ -129,44 +130,107 @@ fn write_record(dir: &Path, rec: &CaseRecord) -> std::io::Result<()> {
     std::fs::rename(&tmp, dir.join("case.json"))
 }
 
-/// Runs case `i` unless it is finished; returns its record.
-pub fn run_case(plan: &Plan, i: usize) -> Result<CaseRecord, SweepError> {
+/// Runs case `i` unless it is finished; returns its record, or
+/// [`SweepError::Interrupted`] when `interrupts` stopped it (it then has a checkpoint and
+/// no `case.json`: the next run of the plan goes on from there).
+pub fn run_case(plan: &Plan, i: usize, interrupts: &Interrupts) -> Result<CaseRecord, SweepError> {
     let dir = plan.case_dir(i);
     if let Some(rec) = finished(plan, i) {
         return Ok(rec);
     }
     if dir.exists() {
-        return restart_incomplete_case(plan, i, &dir);
+        return restart_incomplete_case(plan, i, &dir, interrupts);
     }
-    run_fresh(plan, i, &dir)
+    run_fresh(plan, i, &dir, interrupts)
 }
 
-/// **Restart point (issue 19).** A case directory without a finished `case.json` was
-/// interrupted (killed, Slurm's time limit, a plan changed since): it is run again here
-/// from scratch, its old files removed. When `mecano-rs resume OUTDIR` (checkpoints) is
-/// merged, this is the one place to switch to resuming from the case's checkpoint.
+/// A case directory without a finished `case.json` was stopped (Ctrl-C, Slurm's time
+/// limit, a killed node) or belongs to an edited plan or deck. It goes on from its
+/// checkpoint ([`app::resume_run`]: the files come out as those of a case never stopped)
+/// when the checkpoint is of this case's deck text and values; otherwise (no checkpoint,
+/// a refused one) the case is run again from scratch, its old files removed.
 pub fn restart_incomplete_case(
     plan: &Plan,
     i: usize,
     dir: &Path,
+    interrupts: &Interrupts,
 ) -> Result<CaseRecord, SweepError> {
+    if dir.join(crate::checkpoint::FILE_NAME).exists()
+        && let Ok(ck) = crate::checkpoint::read(dir)
+        && ck.deck.sha256 == plan.deck_hash
+        && same_values(&ck.deck.set, &plan.overrides(i))
+    {
+        let result = app::resume_run(
+            dir,
+            Some(&plan.deck),
+            app::DEFAULT_CHECKPOINT_SECONDS,
+            true,
+            interrupts.clone(),
+        );
+        if let Ok(report) = result {
+            return record(plan, i, dir, Ok(report));
+        }
+    }
     std::fs::remove_dir_all(dir).map_err(|e| SweepError::Io {
         path: dir.to_path_buf(),
         reason: e.to_string(),
     })?;
-    run_fresh(plan, i, dir)
+    run_fresh(plan, i, dir, interrupts)
 }
 
-fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError> {
-    let io = |e: std::io::Error| SweepError::Io {
+/// The values of two override lists agree bit for bit.
+fn same_values(a: &[(String, f64)], b: &[(String, f64)]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.0 == y.0 && x.1.to_bits() == y.1.to_bits())
+}
+
+fn run_fresh(
+    plan: &Plan,
+    i: usize,
+    dir: &Path,
+    interrupts: &Interrupts,
+) -> Result<CaseRecord, SweepError> {
+    std::fs::create_dir_all(dir).map_err(|e| SweepError::Io {
         path: dir.to_path_buf(),
         reason: e.to_string(),
+    })?;
+    let overrides = plan.overrides(i);
+    let text = std::fs::read_to_string(&plan.deck).unwrap_or_default();
+    let result = match crate::deck::load_deck_with(&plan.deck, &overrides) {
+        Err(errs) => Err((app::EXIT_BAD_INPUT, deck_errors_text(&errs))),
+        Ok(model) => {
+            // A case writes every accepted step (EVERY 1, the default) so that its
+            // quantities see the impacts, which a plain run's grid rows can step over
+            // (with h = 5e-5 s on the pendulum the whole first contact falls between two
+            // grid instants); with EVERY n > 1 the deck's sampling is kept.
+            let every_step = model.output.every <= 1;
+            let id = app::deck_identity(&plan.deck, &text, &overrides, 1);
+            app::run_checkpointed(
+                &model,
+                id,
+                dir,
+                app::DEFAULT_CHECKPOINT_SECONDS,
+                every_step,
+                interrupts.clone(),
+            )
+        }
     };
-    std::fs::create_dir_all(dir).map_err(io)?;
-    let values = plan.cases[i].clone();
+    record(plan, i, dir, result)
+}
+
+/// The record of case `i` from the outcome of its run, written as `case.json` — unless
+/// the run was interrupted: then the case is not finished ([`SweepError::Interrupted`]).
+fn record(
+    plan: &Plan,
+    i: usize,
+    dir: &Path,
+    result: Result<crate::solver::RunReport, (u8, String)>,
+) -> Result<CaseRecord, SweepError> {
     let mut rec = CaseRecord {
         case: i,
-        values,
+        values: plan.cases[i].clone(),
         status: Status::Ok,
         diagnosis: String::new(),
         steps: 0,
@@ -176,74 +240,30 @@ fn run_fresh(plan: &Plan, i: usize, dir: &Path) -> Result<CaseRecord, SweepError
         quantity_names: names(plan),
         deck_hash: plan.deck_hash.clone(),
     };
-    let deck_name = plan.deck.display().to_string();
-    match crate::deck::load_deck_with(&plan.deck, &plan.overrides(i)) {
-        Err(errs) => {
+    match result {
+        Err((_, msg)) => {
             rec.status = Status::BadInput;
-            rec.diagnosis = one_line(&deck_errors_text(&errs));
+            rec.diagnosis = one_line(&msg);
         }
-        Ok(model) => match run_model(&model, &deck_name, dir) {
-            Err((_, msg)) => {
-                rec.status = Status::BadInput;
-                rec.diagnosis = one_line(&msg);
+        Ok(report) => {
+            if report.interrupted.is_some() {
+                return Err(SweepError::Interrupted);
             }
-            Ok(report) => {
-                rec.steps = report.stats.steps;
-                rec.time = report.time;
-                rec.cpu_s = report.stats.cpu_seconds;
-                if let Some(f) = &report.failure {
-                    rec.status = Status::Failed;
-                    rec.diagnosis = one_line(&f.to_string());
-                }
-                quantify(plan, dir, &mut rec);
+            rec.steps = report.stats.steps;
+            rec.time = report.time;
+            rec.cpu_s = report.stats.cpu_seconds;
+            if let Some(f) = &report.failure {
+                rec.status = Status::Failed;
+                rec.diagnosis = one_line(&f.to_string());
             }
-        },
+            quantify(plan, dir, &mut rec);
+        }
     }
-    write_record(dir, &rec).map_err(io)?;
+    write_record(dir, &rec).map_err(|e| SweepError::Io {
+        path: dir.to_path_buf(),
+        reason: e.to_string(),
+    })?;
     Ok(rec)
-}
-
-/// [`app::run_model`] for a case: no progress bar, no VTK, and, when the deck writes every
-/// step (`OUTPUT EVERY 1`, the default), *every accepted step*, also the extra steps of
-/// contact events that a plain run leaves out to keep its rows on the instants k·h: the
-/// quantities of interest must see the impacts (with h = 5e-5 s on the pendulum the whole
-/// first contact falls between two grid instants). With `EVERY n > 1` the deck's sampling
-/// is kept (fewer rows for large sweeps; the quantities see those rows only).
-fn run_model(
-    model: &crate::model::Model,
-    deck_name: &str,
-    dir: &Path,
-) -> Result<crate::solver::RunReport, (u8, String)> {
-    use crate::solver;
-    let mut integ = solver::prepare(model).map_err(|e| (app::EXIT_BAD_INPUT, e.to_string()))?;
-    let io = |e: std::io::Error| (app::EXIT_FAILED, format!("{}: {e}", dir.display()));
-    let mut writer =
-        crate::output::Writer::create(dir, deck_name, model, &integ.sys).map_err(io)?;
-    if model.output.every <= 1 {
-        writer.every_accepted_step();
-    }
-    let mut report = match solver::run_prepared(model, &mut integ, &mut writer) {
-        Ok(r) => r,
-        Err(solver::RunError::Output(e)) => solver::RunReport {
-            stats: integ.stats,
-            time: integ.t,
-            interrupted: None,
-            failure: Some(solver::Failure {
-                time: integ.t,
-                step: 0.0,
-                reason: solver::FailureReason::NotFinite,
-                residual_history: vec![],
-                worst: format!("output: {e}"),
-                worst_value: 0.0,
-                reference_force: 0.0,
-                diagnoses: Box::default(),
-            }),
-        },
-        Err(e) => return Err((app::EXIT_BAD_INPUT, e.to_string())),
-    };
-    report.stats = integ.stats;
-    writer.finish(&integ, &report).map_err(io)?;
-    Ok(report)
 }
 
 fn deck_errors_text(errs: &crate::deck::DeckErrors) -> String {
@@ -270,6 +290,7 @@ pub fn run_local(
     which: &[usize],
     jobs: usize,
     quiet: bool,
+    interrupts: &Interrupts,
 ) -> Result<(usize, usize), SweepError> {
     let pending: Vec<usize> = which
         .iter()
@@ -296,13 +317,21 @@ pub fn run_local(
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&i) = pending.get(k) else { break };
+                    if interrupts.stopping() {
+                        break; // a stop was asked for: no new case starts
+                    }
                     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                        run_case(plan, i)
+                        run_case(plan, i, interrupts)
                     }));
                     match r {
                         Ok(Ok(rec)) => {
                             if rec.status != Status::Ok {
                                 not_ok.fetch_add(1, Ordering::Relaxed);
+                            }
+                        }
+                        Ok(Err(SweepError::Interrupted)) => {
+                            if let Ok(mut g) = first_error.lock() {
+                                g.get_or_insert(SweepError::Interrupted);
                             }
                         }
                         Ok(Err(e)) => {
