@@ -24,7 +24,7 @@
 //! velocity (error O(h⁴)) and geodesically in rotation.
 //!
 //! Files: `run.rs` (the runs and their errors per window), `report.rs` (CSV files and the
-//! printed table), `figure.rs` (the work–precision diagram), `space.rs` (the space–time
+//! printed table), `figure.rs` (the work–precision diagram), `space/` (the space–time
 //! study: a ladder of meshes as well as of steps), `cli.rs` (`mecano-rs study`).
 
 mod cli;
