@@ -16,8 +16,10 @@
 //! `[δx, δΘ]`, velocities and accelerations), the coefficients coming from the integrator.
 
 pub mod beam;
+pub mod beam_p;
 pub mod came;
 pub mod joints;
+pub mod lagrange;
 pub mod mass;
 pub mod profile;
 

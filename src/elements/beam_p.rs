@@ -1,0 +1,650 @@
+//! The geometrically exact beam of order `p` (Legendre spectral element, `p + 1` nodes).
+//!
+//! # Kinematics (objective; Crisfield & Jelenić 1999, eqs. 9–12; Jelenić & Crisfield 1999)
+//! Node `i` at parametric position `ξᵢ ∈ [−1, 1]` (the Gauss–Lobatto–Legendre points for a
+//! deck's `ORDER p`, [`super::lagrange::gll`]) carries its position `xᵢ` and the triad
+//! `Λᵢ = Rᵢ Λ⁰ᵢ` (`Λ⁰ᵢ`: the reference triad at the node, axis 1 along the reference axis).
+//! With the **reference node** `r = ⌊p/2⌋` (for `p = 1` the first node) the element works in
+//! local variables that a rigid motion leaves unchanged:
+//! `yᵢ = Λᵣᵀ (xᵢ − xᵣ)`, `ψᵢ = log(Λᵣᵀ Λᵢ)` (the *relative* rotations).
+//! Both are Lagrange-interpolated, `y(ξ) = Σ Nᵢ(ξ) yᵢ`, `ψ(ξ) = Σ Nᵢ(ξ) ψᵢ`, and the triad
+//! field is `Λ(ξ) = Λᵣ exp(ψ̃(ξ))`. The strains (physics.md §2, paper eqs. [5]–[9]) per unit
+//! reference arc length `s` (`ds = J dξ`, `J = |X'(ξ)|`) are
+//! `Γ = exp(ψ̃)ᵀ y_s − Γ⁰`, `K = T(ψ) ψ_s − K⁰`,
+//! (`K̃ = Λᵀ Λ_s` with the material tangent operator `T` of [`crate::rotation::tangent`]),
+//! `Γ⁰`, `K⁰` being the same expressions in the reference configuration — zero strain there
+//! for a straight or a curved reference axis alike (Jelenić & Crisfield 1999, §4).
+//! For `p = 1` this is exactly the two-node element of [`super::beam`].
+//!
+//! A node may be more than π away from the reference node (a cantilever rolled into a full
+//! circle by one element puts its ends ±π from the middle): `ψᵢ` is the branch
+//! `φ̂ (|φ| + 2πk)` of the logarithm `φ` nearest to its neighbour's `ψ`, walking out from
+//! the reference node, so the interpolated field is continuous at any rotation.
+//!
+//! # Quadrature
+//! Strain energy `U = ∫ ½ (Γ·C_N Γ + K·C_M K) ds` by **reduced Gauss quadrature with `p`
+//! points**. Why: `p` points integrate degree `2p − 1` exactly, which is the degree of the
+//! strain energy of the linearised element with its derivative fields `u_s`, `θ_s`, `θ` of
+//! degree `p − 1, p − 1, p`, except the `θ × E₁` part of the shear strain, whose exact
+//! integration is what locks (Prathap & Bhashyam 1982; Reissner/Simo beams, Crisfield 1991
+//! §7.4). No spurious zero-energy mode: zero strains at `p` distinct points make the
+//! degree-`(p − 1)` polynomials `θ_s` and `u_s − θ × E₁` vanish identically, i.e. a rigid
+//! motion — so the stiffness keeps its full rank `6(p + 1) − 6`.
+//! Inertia uses `p + 1` points (exact for the consistent mass of a straight element).
+//!
+//! # Internal forces and exact tangent
+//! `U` is a sum over Gauss points of the energy density of nine local numbers
+//! `(ψ, ψ_s, y_s)` at the point, which depend linearly on the nodal `zᵢ = (yᵢ, ψᵢ)`; each
+//! `zᵢ` depends on node `i` and the reference node only. So, in exponential coordinates
+//! `Rᵢ exp(θ̃ᵢ)` of every node, `U(q) = Ũ(z(q))` and
+//! - forces `f = Zᵀ ∇Ũ` (`Z = ∂z/∂q`),
+//! - Hessian `∇²U = Zᵀ ∇²Ũ Z + Σₐ (∇Ũ)ₐ ∇²zₐ`,
+//!
+//! with the gradient and Hessian of each point's energy density (9 variables) and of each
+//! node's `zᵢ` (12 variables) by second-order dual numbers (`num_dual::Dual2SVec64`), exact to
+//! round-off. The iteration matrix is the derivative of the forces along `Rᵢ exp(ε eₖ)`:
+//! `∂f/∂q = ∇²U + diag(½ f̃_Θᵢ)` on the rotation blocks (the Baker–Campbell–Hausdorff term
+//! `exp(e) exp(θ) = exp(e + θ + ½ e × θ + …)`). Checked against central differences.
+//!
+//! # Inertia (paper eqs. [10]–[11])
+//! Consistent translational mass `Mᵢⱼ = ∫ ρA Nᵢ Nⱼ ds`; rotary inertia at the nodes
+//! `Jᵢ = (∫ Nᵢ ds) Λ⁰ᵢ ρ diag(I₂+I₃, I₂, I₃) Λ⁰ᵢᵀ` in the node's material frame — on GLL nodes
+//! this is the GLL quadrature of the rotary kinetic energy (spectral-element mass lumping,
+//! exact to degree `2p − 1`) — with its gyroscopic force `J Ω̇ + Ω × J Ω`, as the
+//! two-node beam. Gravity: `∫ ρA Nᵢ ds g` on node `i`.
+
+use super::beam::BeamProperties;
+use super::lagrange;
+use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
+use crate::dual::{Dual, Real};
+use crate::model::ElementId;
+use crate::rotation::{self, c, skew};
+use nalgebra::{Const, Matrix3, SMatrix, U1, Vector3};
+use num_dual::Dual2SVec64;
+use std::cell::RefCell;
+use std::f64::consts::PI;
+
+/// The largest order the element accepts (13 nodes beyond which nothing is gained in double
+/// precision for smooth fields; the spectral rules stay accurate well beyond).
+pub const MAX_ORDER: usize = 16;
+
+/// Shape functions of one quadrature point.
+#[derive(Debug, Clone)]
+struct Point {
+    /// `Nᵢ(ξ)`.
+    n: Vec<f64>,
+    /// `dNᵢ/ds = N'ᵢ(ξ)/J`.
+    ds: Vec<f64>,
+    /// Weight times Jacobian, m.
+    wj: f64,
+    /// Reference strains `Γ⁰`, `K⁰`.
+    gamma0: Vector3<f64>,
+    kappa0: Vector3<f64>,
+}
+
+/// A geometrically exact beam of order `p` with `p + 1` nodes.
+#[derive(Debug, Clone)]
+pub struct BeamP {
+    id: ElementId,
+    /// Dense node indices along the axis (first end, interior, last end).
+    nodes: Vec<usize>,
+    /// Reference node `⌊p/2⌋`.
+    refn: usize,
+    /// Reference triads at the nodes.
+    lambda0: Vec<Matrix3<f64>>,
+    props: BeamProperties,
+    /// Stiffness points (`p`, reduced Gauss).
+    stiff: Vec<Point>,
+    /// The element's midpoint `ξ = 0`, for the output of strains.
+    mid: Point,
+    /// Consistent translational mass, `n × n`, row-major, kg.
+    mass: Vec<f64>,
+    /// `∫ ρA Nᵢ ds`, kg.
+    lumped: Vec<f64>,
+    /// Rotary inertia at each node, node material frame.
+    j_node: Vec<Matrix3<f64>>,
+    length: f64,
+}
+
+/// Scratch buffers of the evaluation, one per thread (grown once: no allocation per step).
+#[derive(Default)]
+struct Scratch {
+    shift: Vec<f64>,
+    z: Vec<[f64; 6]>,
+    gz: Vec<[f64; 6]>,
+    jac: Vec<SMatrix<f64, 6, 12>>,
+    hess: Vec<[SMatrix<f64, 12, 12>; 6]>,
+    ht: Vec<SMatrix<f64, 6, 6>>,
+    hp: Vec<SMatrix<f64, 9, 6>>,
+    force: Vec<[f64; 6]>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+impl Scratch {
+    fn size(&mut self, n: usize) {
+        if self.z.len() < n {
+            self.shift.resize(n, 0.0);
+            self.z.resize(n, [0.0; 6]);
+            self.gz.resize(n, [0.0; 6]);
+            self.jac.resize(n, SMatrix::zeros());
+            self.hess.resize(n, [SMatrix::zeros(); 6]);
+            self.ht.resize(n * n, SMatrix::zeros());
+            self.hp.resize(n, SMatrix::zeros());
+            self.force.resize(n, [0.0; 6]);
+        }
+    }
+}
+
+/// `zᵢ = (yᵢ, ψᵢ)` of a node against the reference node, generic in the scalar: node `i` at
+/// `x`, `R exp(θ̃) Λ⁰`, the reference node at `x_r`, `R_r exp(θ̃_r) Λ⁰_r`; `shift = 2πk`
+/// selects the branch of the logarithm.
+#[allow(clippy::too_many_arguments)]
+fn local_vars<S: Real>(
+    x: &Vector3<S>,
+    th: &Vector3<S>,
+    xr: &Vector3<S>,
+    thr: &Vector3<S>,
+    r: &Matrix3<f64>,
+    rr: &Matrix3<f64>,
+    l0: &Matrix3<f64>,
+    l0r: &Matrix3<f64>,
+    shift: f64,
+) -> [S; 6] {
+    let li = rotation::mm(&rotation::mm(&r.map(c), &rotation::exp(th)), &l0.map(c));
+    let lr = rotation::mm(&rotation::mm(&rr.map(c), &rotation::exp(thr)), &l0r.map(c));
+    let mut psi = rotation::log(&rotation::mtm(&lr, &li));
+    if shift != 0.0 {
+        let n = psi.dot(&psi).sqrt();
+        psi *= S::one() + c::<S>(shift) / n;
+    }
+    let y = rotation::mtv(&lr, &(x - xr));
+    [y.x, y.y, y.z, psi.x, psi.y, psi.z]
+}
+
+/// Strains `(Λᵀ x_s, T(ψ) ψ_s)` (before subtracting the reference) from the local numbers
+/// of a point: `ψ`, `ψ_s`, `y_s`.
+fn point_strains<S: Real>(
+    psi: &Vector3<S>,
+    dpsi: &Vector3<S>,
+    dy: &Vector3<S>,
+) -> (Vector3<S>, Vector3<S>) {
+    let e = rotation::exp(psi);
+    (
+        rotation::mtv(&e, dy),
+        rotation::mv(&rotation::tangent(psi), dpsi),
+    )
+}
+
+/// The log branch shift `2πk` of `φ` nearest to `prev`.
+fn branch(phi: &Vector3<f64>, prev: &Vector3<f64>) -> f64 {
+    let n = phi.norm();
+    if n < 1e-8 {
+        return 0.0; // the branches are 2π apart: no choice near the identity
+    }
+    let mut best = (f64::INFINITY, 0.0);
+    for k in -3..=3 {
+        let s = 2.0 * PI * k as f64;
+        let d = (phi * (1.0 + s / n) - prev).norm();
+        if d < best.0 {
+            best = (d, s);
+        }
+    }
+    best.1
+}
+
+impl BeamP {
+    /// A beam through the nodes `nodes` (dense indices, along the axis) at parametric
+    /// positions `xi` (increasing from −1 to 1), reference positions `x0` and reference triads
+    /// `triads` (axis 1 along the reference axis).
+    pub fn new(
+        id: ElementId,
+        nodes: Vec<usize>,
+        xi: &[f64],
+        x0: &[Vector3<f64>],
+        triads: &[Matrix3<f64>],
+        props: BeamProperties,
+    ) -> Self {
+        let n = nodes.len();
+        assert!(n >= 2 && n <= MAX_ORDER + 1 && xi.len() == n && x0.len() == n);
+        let p = n - 1;
+        let point = |x: f64, w: f64| {
+            let (nv, dv) = lagrange::lagrange(xi, x);
+            let dx: Vector3<f64> = dv.iter().zip(x0).map(|(d, x)| x * *d).sum();
+            let jac = dx.norm();
+            Point {
+                n: nv,
+                ds: dv.iter().map(|d| d / jac).collect(),
+                wj: w * jac,
+                gamma0: Vector3::zeros(),
+                kappa0: Vector3::zeros(),
+            }
+        };
+        let (gs, gw) = lagrange::gauss(p);
+        let stiff: Vec<Point> = gs.iter().zip(&gw).map(|(x, w)| point(*x, *w)).collect();
+        let (ms, mw) = lagrange::gauss(p + 1);
+        let mpts: Vec<Point> = ms.iter().zip(&mw).map(|(x, w)| point(*x, *w)).collect();
+        let mut mass = vec![0.0; n * n];
+        let mut lumped = vec![0.0; n];
+        let mut length = 0.0;
+        for q in &mpts {
+            length += q.wj;
+            for i in 0..n {
+                lumped[i] += q.wj * props.mass * q.n[i];
+                for j in 0..n {
+                    mass[i * n + j] += q.wj * props.mass * q.n[i] * q.n[j];
+                }
+            }
+        }
+        // ∫ Nᵢ ds by the mass rule (exact for a straight element: degree p).
+        let j_node = (0..n)
+            .map(|i| {
+                let w = lumped[i] / props.mass.max(f64::MIN_POSITIVE);
+                triads[i] * Matrix3::from_diagonal(&(props.inertia * w)) * triads[i].transpose()
+            })
+            .collect();
+        let mut beam = BeamP {
+            id,
+            nodes,
+            refn: p / 2,
+            lambda0: triads.to_vec(),
+            props,
+            stiff,
+            mid: point(0.0, 0.0),
+            mass,
+            lumped,
+            j_node,
+            length,
+        };
+        // Reference strains: the same expressions at the reference state.
+        let rest: Vec<NodeState> = x0.iter().map(|x| NodeState::at_rest(*x)).collect();
+        let mut z = vec![[0.0; 6]; n];
+        let mut shift = vec![0.0; n];
+        let idx: Vec<usize> = (0..n).collect();
+        beam.locals(&rest, &idx, &mut z, &mut shift);
+        let mut pts = std::mem::take(&mut beam.stiff);
+        pts.push(beam.mid.clone());
+        for q in &mut pts {
+            let (g, k) = Self::strains_at(q, &z);
+            q.gamma0 = g;
+            q.kappa0 = k;
+        }
+        beam.mid = pts.pop().expect("mid point");
+        beam.stiff = pts;
+        beam
+    }
+
+    /// The order `p`.
+    pub fn order(&self) -> usize {
+        self.nodes.len() - 1
+    }
+
+    /// Reference length (arc length of the reference axis), m.
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// Local numbers `zᵢ` and branch shifts of every node (f64); `idx[k]` is node `k`'s index
+    /// into `nodes`.
+    fn locals(&self, nodes: &[NodeState], idx: &[usize], z: &mut [[f64; 6]], shift: &mut [f64]) {
+        let n = idx.len();
+        let m = self.refn;
+        let sr = &nodes[idx[m]];
+        let lr = sr.r * self.lambda0[m];
+        let phi = |k: usize| rotation::log(&(lr.transpose() * nodes[idx[k]].r * self.lambda0[k]));
+        z[m] = [0.0; 6];
+        shift[m] = 0.0;
+        let mut set = |k: usize, prev: Vector3<f64>| {
+            let f = phi(k);
+            let s = branch(&f, &prev);
+            shift[k] = s;
+            let psi = if s != 0.0 {
+                f * (1.0 + s / f.norm())
+            } else {
+                f
+            };
+            let y = lr.transpose() * (nodes[idx[k]].x - sr.x);
+            z[k] = [y.x, y.y, y.z, psi.x, psi.y, psi.z];
+            psi
+        };
+        let mut prev = Vector3::zeros();
+        for k in m + 1..n {
+            prev = set(k, prev);
+        }
+        prev = Vector3::zeros();
+        for k in (0..m).rev() {
+            prev = set(k, prev);
+        }
+    }
+
+    /// The nine local numbers `(ψ, ψ_s, y_s)` of a point.
+    fn point_vars(q: &Point, z: &[[f64; 6]]) -> [f64; 9] {
+        let mut v = [0.0; 9];
+        for (i, zi) in z.iter().enumerate() {
+            for a in 0..3 {
+                v[a] += q.n[i] * zi[3 + a];
+                v[3 + a] += q.ds[i] * zi[3 + a];
+                v[6 + a] += q.ds[i] * zi[a];
+            }
+        }
+        v
+    }
+
+    /// Total strains `(Λᵀx_s, K)` at a point (reference not subtracted).
+    fn strains_at(q: &Point, z: &[[f64; 6]]) -> (Vector3<f64>, Vector3<f64>) {
+        let v = Self::point_vars(q, z);
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        point_strains(&at(0), &at(3), &at(6))
+    }
+
+    /// Energy density `½ Γ·C_N Γ + ½ K·C_M K` at a point from its nine local numbers.
+    fn density<S: Real>(&self, q: &Point, v: &[S; 9]) -> S {
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        let (g, k) = point_strains(&at(0), &at(3), &at(6));
+        let g = g - q.gamma0.map(c::<S>);
+        let k = k - q.kappa0.map(c::<S>);
+        let cn: Vector3<S> = self.props.cn.map(c);
+        let cm: Vector3<S> = self.props.cm.map(c);
+        (g.component_mul(&cn).dot(&g) + k.component_mul(&cm).dot(&k)) * c::<S>(0.5)
+    }
+
+    /// Strains `Γ`, `K` at the element's midpoint `ξ = 0`.
+    pub fn strains(&self, nodes: &[NodeState]) -> (Vector3<f64>, Vector3<f64>) {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let Scratch { z, shift, .. } = &mut *s;
+            self.locals(nodes, &self.nodes, &mut z[..n], &mut shift[..n]);
+            let (g, k) = Self::strains_at(&self.mid, &z[..n]);
+            (g - self.mid.gamma0, k - self.mid.kappa0)
+        })
+    }
+
+    /// The 12 seeds of node `k` against the reference node (x, θ, x_r, θ_r).
+    fn seeds<S: Real>(
+        &self,
+        nodes: &[NodeState],
+        k: usize,
+        var: impl Fn(f64, usize) -> S,
+    ) -> [Vector3<S>; 4] {
+        let (s, sr) = (&nodes[self.nodes[k]], &nodes[self.nodes[self.refn]]);
+        let v = |x: &Vector3<f64>, o: usize| {
+            Vector3::new(var(x.x, o), var(x.y, o + 1), var(x.z, o + 2))
+        };
+        let z = Vector3::zeros();
+        [v(&s.x, 0), v(&z, 3), v(&sr.x, 6), v(&z, 9)]
+    }
+
+    /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
+    /// `tangent` their exact derivative into `out.tan`.
+    fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let sc = &mut *s;
+            let m = self.refn;
+            self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
+            // Jacobians (and Hessians) of the local numbers of every node but the reference.
+            for k in (0..n).filter(|&k| k != m) {
+                let (st, sr) = (&nodes[self.nodes[k]], &nodes[self.nodes[m]]);
+                let (l0, l0r, sh) = (&self.lambda0[k], &self.lambda0[m], sc.shift[k]);
+                if tangent {
+                    type H = Dual2SVec64<12>;
+                    let [x, th, xr, thr] = self.seeds(nodes, k, |v, o| H::from_re(v).derivative(o));
+                    let out = local_vars(&x, &th, &xr, &thr, &st.r, &sr.r, l0, l0r, sh);
+                    for (a, o) in out.into_iter().enumerate() {
+                        let g = o.v1.unwrap_generic(U1, Const::<12>);
+                        for col in 0..12 {
+                            sc.jac[k][(a, col)] = g[col];
+                        }
+                        sc.hess[k][a] = o.v2.unwrap_generic(Const::<12>, Const::<12>);
+                    }
+                } else {
+                    type D = Dual<12>;
+                    let [x, th, xr, thr] = self.seeds(nodes, k, D::var);
+                    let out = local_vars(&x, &th, &xr, &thr, &st.r, &sr.r, l0, l0r, sh);
+                    for (a, o) in out.iter().enumerate() {
+                        for col in 0..12 {
+                            sc.jac[k][(a, col)] = o.eps[col];
+                        }
+                    }
+                }
+            }
+            // Gradient (and Hessian) of Ũ in the local numbers.
+            for g in sc.gz[..n].iter_mut() {
+                *g = [0.0; 6];
+            }
+            if tangent {
+                for h in sc.ht[..n * n].iter_mut() {
+                    *h = SMatrix::zeros();
+                }
+            }
+            for q in &self.stiff {
+                let v = Self::point_vars(q, &sc.z[..n]);
+                let (grad, hess): ([f64; 9], Option<SMatrix<f64, 9, 9>>) = if tangent {
+                    type H = Dual2SVec64<9>;
+                    let vars: [H; 9] = std::array::from_fn(|k| H::from_re(v[k]).derivative(k));
+                    let e = self.density(q, &vars);
+                    let g = e.v1.unwrap_generic(U1, Const::<9>);
+                    (
+                        std::array::from_fn(|k| g[k]),
+                        Some(e.v2.unwrap_generic(Const::<9>, Const::<9>)),
+                    )
+                } else {
+                    let vars: [Dual<9>; 9] = std::array::from_fn(|k| Dual::var(v[k], k));
+                    (self.density(q, &vars).eps, None)
+                };
+                for i in (0..n).filter(|&i| i != m) {
+                    for a in 0..3 {
+                        sc.gz[i][a] += q.wj * q.ds[i] * grad[6 + a];
+                        sc.gz[i][3 + a] += q.wj * (q.n[i] * grad[a] + q.ds[i] * grad[3 + a]);
+                    }
+                }
+                if let Some(h) = hess {
+                    // hp_j = h P_j (9×6), then H̃_ij += wJ P_iᵀ hp_j.
+                    for j in (0..n).filter(|&j| j != m) {
+                        let hp = &mut sc.hp[j];
+                        for r in 0..9 {
+                            for a in 0..3 {
+                                hp[(r, a)] = q.ds[j] * h[(r, 6 + a)];
+                                hp[(r, 3 + a)] = q.n[j] * h[(r, a)] + q.ds[j] * h[(r, 3 + a)];
+                            }
+                        }
+                    }
+                    for i in (0..n).filter(|&i| i != m) {
+                        for j in (0..n).filter(|&j| j != m) {
+                            let hp = &sc.hp[j];
+                            let ht = &mut sc.ht[i * n + j];
+                            for col in 0..6 {
+                                for a in 0..3 {
+                                    ht[(a, col)] += q.wj * q.ds[i] * hp[(6 + a, col)];
+                                    ht[(3 + a, col)] +=
+                                        q.wj * (q.n[i] * hp[(a, col)] + q.ds[i] * hp[(3 + a, col)]);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            // Forces f = Zᵀ ∇Ũ: node k's columns 0..6 of its Jacobian, the reference node's 6..12.
+            for f in sc.force[..n].iter_mut() {
+                *f = [0.0; 6];
+            }
+            for k in (0..n).filter(|&k| k != m) {
+                for col in 0..12 {
+                    let v: f64 = (0..6).map(|a| sc.jac[k][(a, col)] * sc.gz[k][a]).sum();
+                    let node = if col < 6 { k } else { m };
+                    sc.force[node][col % 6] += v;
+                }
+            }
+            for (k, f) in sc.force[..n].iter().enumerate() {
+                for a in 0..6 {
+                    out.res[6 * k + a] += f[a];
+                }
+            }
+            if !tangent {
+                return;
+            }
+            let nl = out.n;
+            let loc = |k: usize, col: usize| {
+                if col < 6 {
+                    6 * k + col
+                } else {
+                    6 * m + col - 6
+                }
+            };
+            // Zᵀ H̃ Z.
+            for i in (0..n).filter(|&i| i != m) {
+                for j in (0..n).filter(|&j| j != m) {
+                    let b = sc.jac[i].transpose() * sc.ht[i * n + j] * sc.jac[j];
+                    for col in 0..12 {
+                        let cc = loc(j, col);
+                        for row in 0..12 {
+                            out.tan[cc * nl + loc(i, row)] += b[(row, col)];
+                        }
+                    }
+                }
+            }
+            // Σₐ (∇Ũ)ₐ ∇²zₐ.
+            for k in (0..n).filter(|&k| k != m) {
+                for col in 0..12 {
+                    let cc = loc(k, col);
+                    for row in 0..12 {
+                        let v: f64 = (0..6)
+                            .map(|a| sc.gz[k][a] * sc.hess[k][a][(row, col)])
+                            .sum();
+                        out.tan[cc * nl + loc(k, row)] += v;
+                    }
+                }
+            }
+            // ½ f̃_Θ on the rotation diagonal blocks.
+            for (k, f) in sc.force[..n].iter().enumerate() {
+                let half = skew(&Vector3::new(f[3], f[4], f[5])) * 0.5;
+                out.add_block(rx(k), rx(k), &half);
+            }
+        })
+    }
+}
+
+impl Element for BeamP {
+    fn id(&self) -> ElementId {
+        self.id
+    }
+
+    fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+
+    fn evaluate(
+        &self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        tangent: bool,
+        out: &mut Local,
+    ) {
+        self.internal(nodes, tangent, out);
+        let n = self.nodes.len();
+        for k in 0..n {
+            out.add_res(tx(k), &(-ctx.gravity * self.lumped[k]));
+        }
+        if !ctx.dynamic {
+            return;
+        }
+        for i in 0..n {
+            let mut f = Vector3::zeros();
+            for j in 0..n {
+                f += nodes[self.nodes[j]].a * self.mass[i * n + j];
+            }
+            out.add_res(tx(i), &f);
+            let s = &nodes[self.nodes[i]];
+            let jw = self.j_node[i] * s.w;
+            out.add_res(rx(i), &(self.j_node[i] * s.wd + s.w.cross(&jw)));
+        }
+        if tangent {
+            for i in 0..n {
+                for j in 0..n {
+                    let mij = Matrix3::identity() * (ctx.c_a * self.mass[i * n + j]);
+                    out.add_rate_block(tx(i), tx(j), &mij);
+                }
+                let (s, jn) = (&nodes[self.nodes[i]], &self.j_node[i]);
+                let gyro = skew(&s.w) * jn - skew(&(jn * s.w));
+                out.add_rate_block(rx(i), rx(i), &(jn * ctx.c_a + gyro * ctx.c_v));
+            }
+        }
+    }
+
+    fn force_scale(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> f64 {
+        let mut f2: f64 = 0.0;
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let (s, m, j) = (&nodes[i], self.lumped[k], &self.j_node[k]);
+            f2 = f2
+                .max(m * m * gravity.norm_squared())
+                .max(m * m * s.a.norm_squared())
+                .max((j * s.wd).norm_squared())
+                .max(s.w.cross(&(j * s.w)).norm_squared());
+        }
+        f2.sqrt()
+    }
+
+    fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {
+        let n = self.nodes.len();
+        let strain = SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            s.size(n);
+            let Scratch { z, shift, .. } = &mut *s;
+            self.locals(nodes, &self.nodes, &mut z[..n], &mut shift[..n]);
+            self.stiff
+                .iter()
+                .map(|q| q.wj * self.density(q, &Self::point_vars(q, &z[..n])))
+                .sum::<f64>()
+        });
+        let mut kinetic = 0.0;
+        let mut grav = 0.0;
+        for i in 0..n {
+            let s = &nodes[self.nodes[i]];
+            for j in 0..n {
+                kinetic += 0.5 * self.mass[i * n + j] * s.v.dot(&nodes[self.nodes[j]].v);
+            }
+            kinetic += 0.5 * s.w.dot(&(self.j_node[i] * s.w));
+            grav -= self.lumped[i] * gravity.dot(&s.x);
+        }
+        Energies {
+            kinetic,
+            strain,
+            gravity: grav,
+        }
+    }
+
+    fn output_header(&self) -> Vec<String> {
+        [
+            "n1", "n2", "n3", "m1", "m2", "m3", "gamma1", "gamma2", "gamma3", "k1", "k2", "k3",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+
+    fn write_output_row(
+        &self,
+        _ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        row: &mut Vec<f64>,
+    ) {
+        let (g, k) = self.strains(nodes);
+        let nn = g.component_mul(&self.props.cn);
+        let mm = k.component_mul(&self.props.cm);
+        for v in [nn, mm, g, k] {
+            row.extend_from_slice(v.as_slice());
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "beam_p_tests.rs"]
+mod tests;
