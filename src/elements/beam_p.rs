@@ -648,3 +648,7 @@ impl Element for BeamP {
 #[cfg(test)]
 #[path = "beam_p_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "beam_p_cases.rs"]
+mod cases;
