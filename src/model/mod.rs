@@ -6,6 +6,7 @@
 //!
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
+pub mod arc;
 mod ids;
 mod summary;
 
