@@ -25,6 +25,8 @@ pub struct RunOptions {
     pub out_dir: Option<PathBuf>,
     /// No progress bar, no summary on standard output.
     pub quiet: bool,
+    /// `--refine k`: divide every beam into k times its elements (0 or 1: as written).
+    pub refine: u32,
 }
 
 /// Parses a deck, printing diagnostics on error.
@@ -35,9 +37,23 @@ pub fn load(path: &Path) -> Result<Model, u8> {
     })
 }
 
-/// `mecano-rs --check DECK`: parse, validate, build the system, print the summary.
-pub fn check(path: &Path) -> u8 {
-    let model = match load(path) {
+/// Parses a deck and refines its mesh by `refine` ([`Model::refine`]; 0 or 1: as
+/// written), printing diagnostics on error.
+pub fn load_refined(path: &Path, refine: u32) -> Result<Model, u8> {
+    let mut model = load(path)?;
+    if refine > 1 {
+        model.refine(refine).map_err(|e| {
+            eprintln!("error: {}: --refine {refine}: {e}", path.display());
+            EXIT_BAD_INPUT
+        })?;
+    }
+    Ok(model)
+}
+
+/// `mecano-rs --check DECK [--refine k]`: parse, validate, refine, build the system, print
+/// the summary (with the nodes and elements generated).
+pub fn check(path: &Path, refine: u32) -> u8 {
+    let model = match load_refined(path, refine) {
         Ok(m) => m,
         Err(code) => return code,
     };
@@ -83,9 +99,21 @@ pub fn run_model(
     dir: &Path,
     quiet: bool,
 ) -> Result<RunReport, (u8, String)> {
+    run_model_refined(model, deck_name, dir, quiet, 1)
+}
+
+/// [`run_model`] for a model refined by `refine` (recorded in `summary.json`).
+pub fn run_model_refined(
+    model: &Model,
+    deck_name: &str,
+    dir: &Path,
+    quiet: bool,
+    refine: u32,
+) -> Result<RunReport, (u8, String)> {
     let mut integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
     let mut writer = Writer::create(dir, deck_name, model, &integ.sys)
         .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+    writer.refine = refine;
     let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
         let pb = indicatif::ProgressBar::new(1000);
         pb.set_style(
@@ -155,7 +183,7 @@ pub fn run_model(
 
 /// `mecano-rs DECK`: parse, run, write; returns the exit code.
 pub fn run(path: &Path, opts: &RunOptions) -> u8 {
-    let model = match load(path) {
+    let model = match load_refined(path, opts.refine) {
         Ok(m) => m,
         Err(code) => return code,
     };
@@ -163,7 +191,13 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         .out_dir
         .clone()
         .unwrap_or_else(|| default_out_dir(path, &model));
-    match run_model(&model, &path.display().to_string(), &dir, opts.quiet) {
+    match run_model_refined(
+        &model,
+        &path.display().to_string(),
+        &dir,
+        opts.quiet,
+        opts.refine.max(1),
+    ) {
         Ok(report) => {
             let st = &report.stats;
             let per = if st.steps > 0 {

@@ -37,6 +37,11 @@ struct Cli {
     /// No progress bar and no closing summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Refine the mesh: divide every BEAM of the deck into K times its elements (a BEAM
+    /// with `DIVIDE n` into K·n). Generated nodes and elements are numbered beyond the
+    /// deck's; the deck's nodes keep their numbers.
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    refine: u32,
 }
 
 /// Subcommands: one variant each, the logic in the library.
@@ -55,12 +60,13 @@ fn main() -> ExitCode {
     let code = match (&cli.command, &cli.deck) {
         (Some(Command::Plot(args)), _) => mecano::plot::run(args),
         (Some(Command::Study(args)), _) => mecano::study::run(args),
-        (None, Some(deck)) if cli.check => mecano::app::check(deck),
+        (None, Some(deck)) if cli.check => mecano::app::check(deck, cli.refine),
         (None, Some(deck)) => mecano::app::run(
             deck,
             &mecano::app::RunOptions {
                 out_dir: cli.out,
                 quiet: cli.quiet,
+                refine: cli.refine,
             },
         ),
         // clap requires DECK when no subcommand is given.

@@ -714,6 +714,16 @@ pub fn deck_of(dir: &Path) -> Result<PathBuf, PlotError> {
         })
 }
 
+/// The `--refine` factor recorded in `dir/summary.json` (1 when absent).
+pub fn refine_of(dir: &Path) -> u32 {
+    std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| v.get("refine").and_then(|r| r.as_u64()))
+        .and_then(|r| u32::try_from(r).ok())
+        .unwrap_or(1)
+}
+
 /// The segments to draw for a model: pairs of node numbers (beams, rigid bodies as chains,
 /// joints), and whether each is a joint.
 pub fn connectivity(model: &Model) -> Vec<(u32, u32, bool)> {
@@ -767,7 +777,9 @@ pub fn animate(a: &AnimateArgs) -> Result<PathBuf, PlotError> {
         });
     }
     // Prints the deck's diagnostics on failure.
-    let model = crate::app::load(&deck).map_err(|_| PlotError::Read {
+    // The run's mesh: a run with --refine k records k in summary.json.
+    let refine = refine_of(&a.run);
+    let model = crate::app::load_refined(&deck, refine).map_err(|_| PlotError::Read {
         file: deck.clone(),
         msg: "the deck has errors (shown above)".into(),
     })?;

@@ -249,6 +249,18 @@ fn malformed_decks_table() {
             "AXIS2 must be a non-zero",
         ),
         (
+            el(" 1 BEAM 1 2 MAT 1 SEC 1 DIVIDE 0"),
+            9,
+            32,
+            "DIVIDE = 0 is out of range: expected 1 to 1000000 elements",
+        ),
+        (
+            el(" 1 BEAM 1 2 MAT 1 SEC 1 DIVIDE 2.5"),
+            9,
+            32,
+            "DIVIDE (number of elements)",
+        ),
+        (
             el(" 1 CAME 1 2 CAM LINE PLANE 1 0 0 2 0 0 FOLLOWER POINT K 1"),
             9,
             22,

@@ -150,6 +150,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw("MAT", "ELEMENTS", "material number of a BEAM"),
     kw("SEC", "ELEMENTS", "section number of a BEAM"),
     kw(
+        "DIVIDE",
+        "ELEMENTS",
+        "BEAM: divide into n equal elements, nodes generated on the axis",
+    ),
+    kw(
         "AXIS2",
         "ELEMENTS",
         "BEAM: local axis 2 direction; UJOINT: axis on the second node",

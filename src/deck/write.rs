@@ -4,8 +4,11 @@
 //! generated nodes and elements are written one per line; every analysis setting is
 //! written explicitly.
 
-use crate::model::{Analysis, ElementKind, Function, Model, PlacedProfile, Profile, Selection};
+use crate::model::{
+    Analysis, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile, Selection,
+};
 use nalgebra::{Matrix3, Vector3};
+use std::collections::HashSet;
 use std::fmt::Write;
 
 fn v3(v: &Vector3<f64>) -> String {
@@ -69,6 +72,18 @@ fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
 /// back (spans aside) for every model `parse_deck` can produce.
 pub fn write_deck(model: &Model) -> String {
     let mut s = String::new();
+    // Generated nodes and elements (DIVIDE) are not written: the BEAM card's DIVIDE
+    // regenerates them with the same numbers.
+    let gen_nodes: HashSet<NodeId> = model
+        .divisions
+        .values()
+        .flat_map(|d| d.interior.iter().copied())
+        .collect();
+    let gen_elements: HashSet<ElementId> = model
+        .divisions
+        .values()
+        .flat_map(|d| d.elements.iter().skip(1).copied())
+        .collect();
     let _ = writeln!(s, "TITLE {}", model.title);
     if !model.materials.is_empty() {
         s.push_str("MATERIALS\n");
@@ -104,7 +119,7 @@ pub fn write_deck(model: &Model) -> String {
     }
     if !model.nodes.is_empty() {
         s.push_str("NODES\n");
-        for n in model.nodes.values() {
+        for n in model.nodes.values().filter(|n| !gen_nodes.contains(&n.id)) {
             let _ = write!(s, "  {} {}", n.id.0, v3(&n.position));
             if n.fixed.iter().any(|f| *f) {
                 let _ = write!(s, " FIX {}", dofs(&n.fixed));
@@ -135,7 +150,14 @@ pub fn write_deck(model: &Model) -> String {
     if !model.elements.is_empty() {
         s.push_str("ELEMENTS\n");
         for e in model.elements.values() {
-            let nodes: Vec<String> = e.nodes.iter().map(|n| n.0.to_string()).collect();
+            if gen_elements.contains(&e.id) {
+                continue;
+            }
+            let division = model.divisions.get(&e.id);
+            let nodes: Vec<String> = match division {
+                Some(d) => d.ends.iter().map(|n| n.0.to_string()).collect(),
+                None => e.nodes.iter().map(|n| n.0.to_string()).collect(),
+            };
             let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
             match &e.kind {
                 ElementKind::Beam {
@@ -146,6 +168,9 @@ pub fn write_deck(model: &Model) -> String {
                     let _ = write!(s, " MAT {} SEC {}", material.0, section.0);
                     if let Some(a) = axis2 {
                         let _ = write!(s, " AXIS2 {}", v3(a));
+                    }
+                    if let Some(d) = division {
+                        let _ = write!(s, " DIVIDE {}", d.count());
                     }
                 }
                 ElementKind::Mass { mass, inertia } => {
@@ -203,9 +228,13 @@ pub fn write_deck(model: &Model) -> String {
             s.push('\n');
         }
     }
-    if !model.initial.is_empty() {
+    if model.initial.iter().any(|iv| !gen_nodes.contains(&iv.node)) {
         s.push_str("INITIAL\n");
-        for iv in &model.initial {
+        for iv in model
+            .initial
+            .iter()
+            .filter(|iv| !gen_nodes.contains(&iv.node))
+        {
             let _ = writeln!(
                 s,
                 "  {} V {} W {}",

@@ -8,10 +8,12 @@
 
 pub mod arc;
 mod ids;
+mod mesh;
 mod summary;
 
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
-pub use summary::{Effects, Summary};
+pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
+pub use summary::{Effects, Generated, Summary};
 
 use indexmap::IndexMap;
 use nalgebra::{Matrix3, Vector3};
@@ -495,6 +497,10 @@ pub struct Model {
     pub analysis: Analysis,
     /// Output requests.
     pub output: OutputRequest,
+    /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the
+    /// beam's number, in deck order; their generated nodes and elements are in `nodes` and
+    /// `elements` (see [`mesh`](self::Division) for the numbering).
+    pub divisions: IndexMap<ElementId, Division>,
 }
 
 #[cfg(test)]

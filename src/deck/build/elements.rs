@@ -55,8 +55,8 @@ impl Builder<'_> {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 let mut seen = Seen::default();
-                let (mut mat, mut sec, mut axis2) = (None, None, None);
-                const KW: [&str; 3] = ["MAT", "SEC", "AXIS2"];
+                let (mut mat, mut sec, mut axis2, mut divide) = (None, None, None, None);
+                const KW: [&str; 4] = ["MAT", "SEC", "AXIS2", "DIVIDE"];
                 while let Some(t) = c.peek() {
                     let Some((kw, ks)) = c.keyword(&KW) else {
                         return Err(c.unexpected(t, &expected_list(&KW)));
@@ -65,6 +65,16 @@ impl Builder<'_> {
                     match kw {
                         "MAT" => mat = Some(c.uint("material number")?),
                         "SEC" => sec = Some(c.uint("section number")?),
+                        "DIVIDE" => {
+                            let t = c.peek();
+                            let (n, ns) = c.uint("DIVIDE (number of elements)")?;
+                            if n == 0 || n > MAX_GENERATION {
+                                let text = t.map_or("", |t| t.text);
+                                let range = format!("1 to {MAX_GENERATION} elements");
+                                return Err(out_of_range("DIVIDE", text, &range, ns));
+                            }
+                            divide = Some(n);
+                        }
                         _ => axis2 = Some(c.axis("AXIS2")?),
                     }
                 }
@@ -106,6 +116,7 @@ impl Builder<'_> {
                     (n1, n2),
                     (MaterialId(mat), SectionId(sec)),
                     axis2.map(|(u, _, s)| (u, s)),
+                    divide.unwrap_or(1),
                     span,
                     id_span,
                 );
@@ -239,6 +250,7 @@ impl Builder<'_> {
         ((n1, s1), (n2, s2)): ((u32, Span), (u32, Span)),
         (material, section): (MaterialId, SectionId),
         axis2: Option<(Vector3<f64>, Span)>,
+        divide: u32,
         span: Span,
         id_span: Span,
     ) -> R<()> {
@@ -298,6 +310,9 @@ impl Builder<'_> {
                 span,
                 id_span,
             );
+            if divide > 1 {
+                self.divide.push((ElementId(id), divide, span));
+            }
         }
         Ok(())
     }

@@ -49,6 +49,8 @@ struct Builder<'s> {
     initial: Vec<InitialVelocity>,
     analysis: Option<(Analysis, Span)>,
     output: Option<(OutputRequest, Span)>,
+    /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
+    divide: Vec<(ElementId, u32, Span)>,
 }
 
 impl<'s> Builder<'s> {
@@ -134,6 +136,7 @@ pub(crate) fn build_model(
         initial: Vec::new(),
         analysis: None,
         output: None,
+        divide: Vec::new(),
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -199,7 +202,7 @@ pub(crate) fn build_model(
     if !b.errors.is_empty() {
         return Err(b.errors);
     }
-    Ok(Model {
+    let mut model = Model {
         title: b.title.map_or_else(|| "untitled".to_string(), |t| t.0),
         nodes: b.nodes,
         materials: b.materials,
@@ -211,5 +214,23 @@ pub(crate) fn build_model(
         initial: b.initial,
         analysis,
         output: b.output.map(|o| o.0).unwrap_or_default(),
-    })
+        divisions: IndexMap::new(),
+    };
+    // Generated numbers start past every user number: divide once all are known.
+    let mut numbering = crate::model::Numbering::after(&model);
+    for (beam, n, span) in b.divide {
+        if let Err(e) = model.divide_beam(beam, n, &mut numbering) {
+            let reason = e.to_string();
+            let err = DeckError::new(
+                K::BadGeneration {
+                    first: beam.0,
+                    last: beam.0,
+                    reason,
+                },
+                span,
+            );
+            return Err(vec![err]);
+        }
+    }
+    Ok(model)
 }
