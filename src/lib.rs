@@ -11,6 +11,7 @@ pub mod app;
 pub mod deck;
 pub mod dual;
 pub mod elements;
+pub mod lagrange;
 pub mod model;
 pub mod output;
 pub mod plot;

@@ -2,7 +2,7 @@
 //!
 //! # Kinematics (objective; Crisfield & Jelenić 1999, eqs. 9–12; Jelenić & Crisfield 1999)
 //! Node `i` at parametric position `ξᵢ ∈ [−1, 1]` (the Gauss–Lobatto–Legendre points for a
-//! deck's `ORDER p`, [`super::lagrange::gll`]) carries its position `xᵢ` and the triad
+//! deck's `ORDER p`, [`crate::lagrange::gll`]) carries its position `xᵢ` and the triad
 //! `Λᵢ = Rᵢ Λ⁰ᵢ` (`Λ⁰ᵢ`: the reference triad at the node, axis 1 along the reference axis).
 //! With the **reference node** `r = ⌊p/2⌋` (for `p = 1` the first node) the element works in
 //! local variables that a rigid motion leaves unchanged:
@@ -53,11 +53,13 @@
 //! exact to degree `2p − 1`) — with its gyroscopic force `J Ω̇ + Ω × J Ω`, as the
 //! two-node beam. Gravity: `∫ ρA Nᵢ ds g` on node `i`.
 
-use super::beam::BeamProperties;
-use super::lagrange;
+use super::beam::{Beam, BeamProperties, default_axis2, reference_triad};
 use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::dual::{Dual, Real};
+use crate::lagrange;
 use crate::model::ElementId;
+use crate::model::arc::Arc;
+use crate::model::{ElementKind, Model};
 use crate::rotation::{self, c, skew};
 use nalgebra::{Const, Matrix3, SMatrix, U1, Vector3};
 use num_dual::Dual2SVec64;
@@ -195,6 +197,76 @@ fn branch(phi: &Vector3<f64>, prev: &Vector3<f64>) -> f64 {
     best.1
 }
 
+/// The solver element of a model's beam whose nodes (dense indices, along the axis) are
+/// `nodes`: the two-node [`super::beam::Beam`] for two nodes (fast path; an `ARC` beam of
+/// order 1 is a chord of its arc), a [`BeamP`] of order `nodes.len() − 1` otherwise, with
+/// the nodes at the GLL points and reference triads along the straight or curved axis:
+/// `t₁` the unit tangent (chord direction, or the arc's tangent at the node), `t₂` the
+/// `AXIS2` direction made normal to `t₁` (default: [`super::beam::default_axis2`] of the
+/// chord, or the normal of the arc's plane), `t₃ = t₁ × t₂`.
+pub fn from_model(
+    model: &Model,
+    el: &crate::model::Element,
+    nodes: Vec<usize>,
+) -> Box<dyn Element> {
+    let ElementKind::Beam {
+        material,
+        section,
+        axis2,
+        arc,
+        ..
+    } = &el.kind
+    else {
+        unreachable!("from_model is called on beams only")
+    };
+    let (mat, sec) = (&model.materials[material], &model.sections[section]);
+    let props = BeamProperties {
+        cn: Vector3::new(
+            mat.young * sec.area,
+            sec.shear_factor * mat.shear * sec.area,
+            sec.shear_factor * mat.shear * sec.area,
+        ),
+        cm: Vector3::new(
+            mat.shear * sec.torsion,
+            mat.young * sec.i2,
+            mat.young * sec.i3,
+        ),
+        mass: mat.density * sec.area,
+        inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
+    };
+    let x0: Vec<Vector3<f64>> = nodes.iter().map(|&i| model.nodes[i].position).collect();
+    let (xa, xb) = (x0[0], x0[x0.len() - 1]);
+    if nodes.len() == 2 {
+        return Box::new(Beam::new(
+            el.id,
+            [nodes[0], nodes[1]],
+            &xa,
+            &xb,
+            *axis2,
+            props,
+        ));
+    }
+    let curved = arc.and_then(|c| Arc::new(&xa, &xb, &c).ok());
+    let triads: Vec<Matrix3<f64>> = x0
+        .iter()
+        .map(|x| match &curved {
+            Some(a) => {
+                let t1 = a.tangent_at(x);
+                let ax = axis2.unwrap_or_else(|| a.normal());
+                let t2 = (ax - t1 * t1.dot(&ax)).normalize();
+                Matrix3::from_columns(&[t1, t2, t1.cross(&t2)])
+            }
+            None => reference_triad(
+                &xa,
+                &xb,
+                &axis2.unwrap_or_else(|| default_axis2(&(xb - xa))),
+            ),
+        })
+        .collect();
+    let (xi, _) = lagrange::gll(nodes.len() - 1);
+    Box::new(BeamP::new(el.id, nodes, &xi, &x0, &triads, props))
+}
+
 impl BeamP {
     /// A beam through the nodes `nodes` (dense indices, along the axis) at parametric
     /// positions `xi` (increasing from −1 to 1), reference positions `x0` and reference triads
@@ -208,7 +280,7 @@ impl BeamP {
         props: BeamProperties,
     ) -> Self {
         let n = nodes.len();
-        assert!(n >= 2 && n <= MAX_ORDER + 1 && xi.len() == n && x0.len() == n);
+        assert!((2..=MAX_ORDER + 1).contains(&n) && xi.len() == n && x0.len() == n);
         let p = n - 1;
         let point = |x: f64, w: f64| {
             let (nv, dv) = lagrange::lagrange(xi, x);

@@ -37,7 +37,8 @@ impl Arc {
     pub fn new(a: &Vector3<f64>, b: &Vector3<f64>, centre: &Vector3<f64>) -> Result<Arc, ArcError> {
         let (ra, rb) = (a - centre, b - centre);
         let (la, lb) = (ra.norm(), rb.norm());
-        if !((la - lb).abs() <= 1e-6 * la.max(lb)) || la == 0.0 {
+        let equal = (la - lb).abs() <= 1e-6 * la.max(lb);
+        if !equal || la == 0.0 || !la.is_finite() {
             return Err(ArcError::Radii(la, lb));
         }
         let n = ra.cross(&rb);
@@ -69,6 +70,32 @@ impl Arc {
         self.e2 * t.cos() - self.e1 * t.sin()
     }
 
+    /// Unit normal of the arc's plane, `(a − c) × (b − c)` normalised.
+    pub fn normal(&self) -> Vector3<f64> {
+        self.e1.cross(&self.e2)
+    }
+
+    /// Unit tangent at a point `x` of the arc's circle (in the sense from `a` to `b`).
+    pub fn tangent_at(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        self.normal().cross(&(x - self.centre)).normalize()
+    }
+
+    /// Whether the direction `v` is parallel to the tangent somewhere on the arc: with
+    /// `v = v₁e₁ + v₂e₂ + v₃n`, `v × t(φ) = (v₁ cos φ + v₂ sin φ) n + …` vanishes only if
+    /// `v₃ = 0` (to 1e-6) and `φ ≡ atan2(−v₁, v₂) (mod π)` lies in `[0, θ]`.
+    pub fn meets_tangent(&self, v: &Vector3<f64>) -> bool {
+        let v = v.normalize();
+        if v.dot(&self.normal()).abs() > 1e-6 {
+            return false;
+        }
+        let phi = (-v.dot(&self.e1)).atan2(v.dot(&self.e2));
+        let tol = 1e-6;
+        [-1.0, 0.0, 1.0, 2.0]
+            .iter()
+            .map(|k| phi + k * std::f64::consts::PI)
+            .any(|p| p >= -tol && p <= self.angle + tol)
+    }
+
     /// Arc length.
     pub fn length(&self) -> f64 {
         self.radius * self.angle
@@ -92,6 +119,10 @@ mod tests {
         let h = 0.5 * q;
         let mid = Vector3::new(r * h.sin(), r * (1.0 - h.cos()), 0.0);
         assert!((arc.point(0.5) - mid).norm() < 1e-12);
+        assert!(!arc.meets_tangent(&Vector3::z()));
+        assert!(arc.meets_tangent(&Vector3::new(1.0, 0.2, 0.0)));
+        assert!(!arc.meets_tangent(&Vector3::y()));
+        assert!((arc.tangent_at(&arc.point(0.3)) - arc.tangent(0.3)).norm() < 1e-15);
         assert_eq!(
             Arc::new(&a, &(b * 2.0), &c),
             Err(ArcError::Radii(r, (b * 2.0 - c).norm()))
