@@ -6,6 +6,7 @@
 
 pub mod integrator;
 pub mod linear;
+pub mod redundancy;
 pub mod system;
 
 pub use integrator::{HhtParams, Integrator, StepInfo};
