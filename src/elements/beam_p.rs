@@ -115,7 +115,8 @@ struct Scratch {
     z: Vec<[f64; 6]>,
     gz: Vec<[f64; 6]>,
     jac: Vec<SMatrix<f64, 6, 12>>,
-    hess: Vec<[SMatrix<f64, 12, 12>; 6]>,
+    /// Hessians of the three components of ψᵢ in (θᵢ, θᵣ).
+    hess: Vec<[SMatrix<f64, 6, 6>; 3]>,
     ht: Vec<SMatrix<f64, 6, 6>>,
     hp: Vec<SMatrix<f64, 9, 6>>,
     force: Vec<[f64; 6]>,
@@ -132,7 +133,7 @@ impl Scratch {
             self.z.resize(n, [0.0; 6]);
             self.gz.resize(n, [0.0; 6]);
             self.jac.resize(n, SMatrix::zeros());
-            self.hess.resize(n, [SMatrix::zeros(); 6]);
+            self.hess.resize(n, [SMatrix::zeros(); 3]);
             self.ht.resize(n * n, SMatrix::zeros());
             self.hp.resize(n, SMatrix::zeros());
             self.force.resize(n, [0.0; 6]);
@@ -435,24 +436,14 @@ impl BeamP {
         })
     }
 
-    /// The 12 seeds of node `k` against the reference node (x, θ, x_r, θ_r).
-    fn seeds<S: Real>(
-        &self,
-        nodes: &[NodeState],
-        k: usize,
-        var: impl Fn(f64, usize) -> S,
-    ) -> [Vector3<S>; 4] {
-        let (s, sr) = (&nodes[self.nodes[k]], &nodes[self.nodes[self.refn]]);
-        let v = |x: &Vector3<f64>, o: usize| {
-            Vector3::new(var(x.x, o), var(x.y, o + 1), var(x.z, o + 2))
-        };
-        let z = Vector3::zeros();
-        [v(&s.x, 0), v(&z, 3), v(&sr.x, 6), v(&z, 9)]
-    }
-
-    /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
-    /// `tangent` their exact derivative into `out.tan`.
-    fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
+    /// Internal forces only (the residual path, evaluated at every Newton iteration): the
+    /// chain rule of the module doc with the Jacobian of the local numbers in closed form,
+    /// `∂yᵢ/∂xᵢ = Λᵣᵀ = −∂yᵢ/∂xᵣ`, `∂yᵢ/∂θᵣ = ỹᵢ Λ⁰ᵣᵀ`,
+    /// `∂ψᵢ/∂θᵢ = T⁻¹(ψᵢ) Λ⁰ᵢᵀ`, `∂ψᵢ/∂θᵣ = −T⁻¹(ψᵢ) exp(ψ̃ᵢ)ᵀ Λ⁰ᵣᵀ`
+    /// (from `exp(ψ̃ᵢ) = Λᵣᵀ Λᵢ`, `δ exp(ψ̃) = exp(ψ̃)(T(ψ) δψ)~`), and the gradient of each
+    /// point's energy density `∂e/∂y_s = exp(ψ̃) N`, `∂e/∂ψ_s = T(ψ)ᵀ M`, `∂e/∂ψ` by a
+    /// 3-direction dual number. Same numbers as the tangent path to round-off (tested).
+    fn internal_forces(&self, nodes: &[NodeState], out: &mut Local) {
         SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
             let n = self.nodes.len();
@@ -460,63 +451,135 @@ impl BeamP {
             let sc = &mut *s;
             let m = self.refn;
             self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
-            // Jacobians (and Hessians) of the local numbers of every node but the reference.
+            for g in sc.gz[..n].iter_mut() {
+                *g = [0.0; 6];
+            }
+            let cn = self.props.cn;
+            let cm = self.props.cm;
+            for q in &self.stiff {
+                let v = Self::point_vars(q, &sc.z[..n]);
+                let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+                let (psi, dpsi, dy) = (at(0), at(3), at(6));
+                let e = rotation::exp(&psi);
+                let t = rotation::tangent(&psi);
+                let a = e.transpose() * dy;
+                let gamma = a - q.gamma0;
+                let kappa = t * dpsi - q.kappa0;
+                let nn = gamma.component_mul(&cn);
+                let mm = kappa.component_mul(&cm);
+                let g_dy = e * nn;
+                let g_dpsi = t.transpose() * mm;
+                // ∂e/∂ψ: dual numbers on ψ only.
+                let pd = Vector3::new(
+                    Dual::<3>::var(psi.x, 0),
+                    Dual::var(psi.y, 1),
+                    Dual::var(psi.z, 2),
+                );
+                let vars: [Dual<3>; 9] =
+                    std::array::from_fn(|k| if k < 3 { pd[k] } else { Dual::constant(v[k]) });
+                let g_psi = self.density(q, &vars).eps;
+                for i in (0..n).filter(|&i| i != m) {
+                    for k in 0..3 {
+                        sc.gz[i][k] += q.wj * q.ds[i] * g_dy[k];
+                        sc.gz[i][3 + k] += q.wj * (q.n[i] * g_psi[k] + q.ds[i] * g_dpsi[k]);
+                    }
+                }
+            }
+            let sr = &nodes[self.nodes[m]];
+            let lr = sr.r * self.lambda0[m];
+            let l0r = &self.lambda0[m];
+            let (mut fxr, mut fthr) = (Vector3::zeros(), Vector3::zeros());
+            for i in (0..n).filter(|&i| i != m) {
+                let z = &sc.z[i];
+                let (y, psi) = (
+                    Vector3::new(z[0], z[1], z[2]),
+                    Vector3::new(z[3], z[4], z[5]),
+                );
+                let gy = Vector3::new(sc.gz[i][0], sc.gz[i][1], sc.gz[i][2]);
+                let gp = Vector3::new(sc.gz[i][3], sc.gz[i][4], sc.gz[i][5]);
+                let fx = lr * gy;
+                let tig = rotation::tangent_inv(&psi).transpose() * gp;
+                let fth = self.lambda0[i] * tig;
+                fxr -= fx;
+                fthr += l0r * (gy.cross(&y) - rotation::exp(&psi) * tig);
+                out.add_res(tx(i), &fx);
+                out.add_res(rx(i), &fth);
+            }
+            out.add_res(tx(m), &fxr);
+            out.add_res(rx(m), &fthr);
+        })
+    }
+
+    /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
+    /// `tangent` their exact derivative into `out.tan` (second-order duals, module doc).
+    fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
+        if !tangent {
+            return self.internal_forces(nodes, out);
+        }
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let sc = &mut *s;
+            let m = self.refn;
+            self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
+            // Jacobians of the local numbers of every node but the reference, columns
+            // (xᵢ, θᵢ, xᵣ, θᵣ): y in closed form (see `internal_forces`), ψ and its Hessian in
+            // (θᵢ, θᵣ) by 6-direction second-order duals (ψ does not depend on positions).
+            let sr = &nodes[self.nodes[m]];
+            let lr = sr.r * self.lambda0[m];
+            let l0r = &self.lambda0[m];
             for k in (0..n).filter(|&k| k != m) {
-                let (st, sr) = (&nodes[self.nodes[k]], &nodes[self.nodes[m]]);
-                let (l0, l0r, sh) = (&self.lambda0[k], &self.lambda0[m], sc.shift[k]);
-                if tangent {
-                    type H = Dual2SVec64<12>;
-                    let [x, th, xr, thr] = self.seeds(nodes, k, |v, o| H::from_re(v).derivative(o));
-                    let out = local_vars(&x, &th, &xr, &thr, &st.r, &sr.r, l0, l0r, sh);
-                    for (a, o) in out.into_iter().enumerate() {
-                        let g = o.v1.unwrap_generic(U1, Const::<12>);
-                        for col in 0..12 {
-                            sc.jac[k][(a, col)] = g[col];
-                        }
-                        sc.hess[k][a] = o.v2.unwrap_generic(Const::<12>, Const::<12>);
+                let st = &nodes[self.nodes[k]];
+                let (l0, sh) = (&self.lambda0[k], sc.shift[k]);
+                type H = Dual2SVec64<6>;
+                let th = Vector3::from_fn(|a, _| H::from_re(0.0).derivative(a));
+                let thr = Vector3::from_fn(|a, _| H::from_re(0.0).derivative(3 + a));
+                let zero = Vector3::from_element(H::from_re(0.0));
+                let psi = local_vars(&zero, &th, &zero, &thr, &st.r, &sr.r, l0, l0r, sh);
+                let z = &sc.z[k];
+                let y = Vector3::new(z[0], z[1], z[2]);
+                let jac = &mut sc.jac[k];
+                *jac = SMatrix::zeros();
+                let yr = skew(&y) * l0r.transpose();
+                for r in 0..3 {
+                    for c in 0..3 {
+                        jac[(r, c)] = lr[(c, r)];
+                        jac[(r, 6 + c)] = -lr[(c, r)];
+                        jac[(r, 9 + c)] = yr[(r, c)];
                     }
-                } else {
-                    type D = Dual<12>;
-                    let [x, th, xr, thr] = self.seeds(nodes, k, D::var);
-                    let out = local_vars(&x, &th, &xr, &thr, &st.r, &sr.r, l0, l0r, sh);
-                    for (a, o) in out.iter().enumerate() {
-                        for col in 0..12 {
-                            sc.jac[k][(a, col)] = o.eps[col];
-                        }
+                }
+                for a in 0..3 {
+                    let o = &psi[3 + a];
+                    let g = o.v1.unwrap_generic(U1, Const::<6>);
+                    for c in 0..3 {
+                        jac[(3 + a, 3 + c)] = g[c];
+                        jac[(3 + a, 9 + c)] = g[3 + c];
                     }
+                    sc.hess[k][a] = o.v2.unwrap_generic(Const::<6>, Const::<6>);
                 }
             }
             // Gradient (and Hessian) of Ũ in the local numbers.
             for g in sc.gz[..n].iter_mut() {
                 *g = [0.0; 6];
             }
-            if tangent {
-                for h in sc.ht[..n * n].iter_mut() {
-                    *h = SMatrix::zeros();
-                }
+            for h in sc.ht[..n * n].iter_mut() {
+                *h = SMatrix::zeros();
             }
             for q in &self.stiff {
                 let v = Self::point_vars(q, &sc.z[..n]);
-                let (grad, hess): ([f64; 9], Option<SMatrix<f64, 9, 9>>) = if tangent {
-                    type H = Dual2SVec64<9>;
-                    let vars: [H; 9] = std::array::from_fn(|k| H::from_re(v[k]).derivative(k));
-                    let e = self.density(q, &vars);
-                    let g = e.v1.unwrap_generic(U1, Const::<9>);
-                    (
-                        std::array::from_fn(|k| g[k]),
-                        Some(e.v2.unwrap_generic(Const::<9>, Const::<9>)),
-                    )
-                } else {
-                    let vars: [Dual<9>; 9] = std::array::from_fn(|k| Dual::var(v[k], k));
-                    (self.density(q, &vars).eps, None)
-                };
+                type H = Dual2SVec64<9>;
+                let vars: [H; 9] = std::array::from_fn(|k| H::from_re(v[k]).derivative(k));
+                let e = self.density(q, &vars);
+                let grad = e.v1.unwrap_generic(U1, Const::<9>);
+                let h = e.v2.unwrap_generic(Const::<9>, Const::<9>);
                 for i in (0..n).filter(|&i| i != m) {
                     for a in 0..3 {
                         sc.gz[i][a] += q.wj * q.ds[i] * grad[6 + a];
                         sc.gz[i][3 + a] += q.wj * (q.n[i] * grad[a] + q.ds[i] * grad[3 + a]);
                     }
                 }
-                if let Some(h) = hess {
+                {
                     // hp_j = h P_j (9×6), then H̃_ij += wJ P_iᵀ hp_j.
                     for j in (0..n).filter(|&j| j != m) {
                         let hp = &mut sc.hp[j];
@@ -558,9 +621,6 @@ impl BeamP {
                     out.res[6 * k + a] += f[a];
                 }
             }
-            if !tangent {
-                return;
-            }
             let nl = out.n;
             let loc = |k: usize, col: usize| {
                 if col < 6 {
@@ -581,15 +641,41 @@ impl BeamP {
                     }
                 }
             }
-            // Σₐ (∇Ũ)ₐ ∇²zₐ.
+            // Σₐ (∇Ũ)ₐ ∇²zₐ. ψ: the dual Hessians in (θᵢ, θᵣ). y = Λ⁰ᵣᵀ exp(−θ̃ᵣ) Rᵣᵀ (xᵢ − xᵣ):
+            // with u = Λ⁰ᵣ g_y, w = Rᵣᵀ(xᵢ − xᵣ), g_y·y = u·exp(−θ̃ᵣ) w has the Hessian
+            // ½(u wᵀ + w uᵀ) − (u·w) I in θᵣ and ũ Rᵣᵀ in (θᵣ, xᵢ) (−ũ Rᵣᵀ in (θᵣ, xᵣ)).
             for k in (0..n).filter(|&k| k != m) {
+                let gz = &sc.gz[k];
+                let mut sec = SMatrix::<f64, 12, 12>::zeros();
+                for a in 0..3 {
+                    let h = &sc.hess[k][a];
+                    for r in 0..6 {
+                        for c in 0..6 {
+                            // 6-index (θᵢ 0..3, θᵣ 3..6) → 12-index (3..6, 9..12).
+                            let (rr, cc) = (r + 3 + 3 * (r / 3), c + 3 + 3 * (c / 3));
+                            sec[(rr, cc)] += gz[3 + a] * h[(r, c)];
+                        }
+                    }
+                }
+                let gy = Vector3::new(gz[0], gz[1], gz[2]);
+                let u = l0r * gy;
+                let w = sr.r.transpose() * (nodes[self.nodes[k]].x - sr.x);
+                let hrr =
+                    (u * w.transpose() + w * u.transpose()) * 0.5 - Matrix3::identity() * u.dot(&w);
+                let mix = skew(&u) * sr.r.transpose();
+                for r in 0..3 {
+                    for c in 0..3 {
+                        sec[(9 + r, 9 + c)] += hrr[(r, c)];
+                        sec[(9 + r, c)] += mix[(r, c)];
+                        sec[(9 + r, 6 + c)] -= mix[(r, c)];
+                        sec[(c, 9 + r)] += mix[(r, c)];
+                        sec[(6 + c, 9 + r)] -= mix[(r, c)];
+                    }
+                }
                 for col in 0..12 {
                     let cc = loc(k, col);
                     for row in 0..12 {
-                        let v: f64 = (0..6)
-                            .map(|a| sc.gz[k][a] * sc.hess[k][a][(row, col)])
-                            .sum();
-                        out.tan[cc * nl + loc(k, row)] += v;
+                        out.tan[cc * nl + loc(k, row)] += sec[(row, col)];
                     }
                 }
             }
