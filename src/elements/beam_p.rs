@@ -40,9 +40,11 @@
 //! - forces `f = Zᵀ ∇Ũ` (`Z = ∂z/∂q`),
 //! - Hessian `∇²U = Zᵀ ∇²Ũ Z + Σₐ (∇Ũ)ₐ ∇²zₐ`,
 //!
-//! with the gradient and Hessian of each point's energy density (9 variables) and of each
-//! node's `zᵢ` (12 variables) by second-order dual numbers (`num_dual::Dual2SVec64`), exact to
-//! round-off. The iteration matrix is the derivative of the forces along `Rᵢ exp(ε eₖ)`:
+//! with the gradient of each point's energy density (9 variables) and the Jacobian `Z` in
+//! closed form ([`BeamP::density_grad`], `internal_forces`), and the second derivatives as
+//! forward-mode derivatives of those gradients by the fixed-size [`Dual`] numbers (9 directions
+//! per point, 6 per node for `ψᵢ(θᵢ, θᵣ)`; `yᵢ` is linear in the positions and its Hessian
+//! is written out): exact to round-off, at `O(n²)` per element. The iteration matrix is the derivative of the forces along `Rᵢ exp(ε eₖ)`:
 //! `∂f/∂q = ∇²U + diag(½ f̃_Θᵢ)` on the rotation blocks (the Baker–Campbell–Hausdorff term
 //! `exp(e) exp(θ) = exp(e + θ + ½ e × θ + …)`). Checked against central differences.
 //!
@@ -61,8 +63,7 @@ use crate::model::ElementId;
 use crate::model::arc::Arc;
 use crate::model::{ElementKind, Model};
 use crate::rotation::{self, c, skew};
-use nalgebra::{Const, Matrix3, SMatrix, U1, Vector3};
-use num_dual::Dual2SVec64;
+use nalgebra::{Matrix3, SMatrix, Vector3};
 use std::cell::RefCell;
 use std::f64::consts::PI;
 
@@ -115,8 +116,6 @@ struct Scratch {
     z: Vec<[f64; 6]>,
     gz: Vec<[f64; 6]>,
     jac: Vec<SMatrix<f64, 6, 12>>,
-    /// Hessians of the three components of ψᵢ in (θᵢ, θᵣ).
-    hess: Vec<[SMatrix<f64, 6, 6>; 3]>,
     ht: Vec<SMatrix<f64, 6, 6>>,
     hp: Vec<SMatrix<f64, 9, 6>>,
     force: Vec<[f64; 6]>,
@@ -133,7 +132,6 @@ impl Scratch {
             self.z.resize(n, [0.0; 6]);
             self.gz.resize(n, [0.0; 6]);
             self.jac.resize(n, SMatrix::zeros());
-            self.hess.resize(n, [SMatrix::zeros(); 3]);
             self.ht.resize(n * n, SMatrix::zeros());
             self.hp.resize(n, SMatrix::zeros());
             self.force.resize(n, [0.0; 6]);
@@ -179,6 +177,31 @@ fn point_strains<S: Real>(
         rotation::mtv(&e, dy),
         rotation::mv(&rotation::tangent(psi), dpsi),
     )
+}
+
+/// `(b, d, b′, d′)` with `b = (1 − cos φ)/φ²`, `d = (φ − sin φ)/φ³` (so that
+/// `T(ψ) = I − b ψ̃ + d ψ̃²`) and their derivatives with respect to `x = φ²`:
+/// `b′ = (φ sin φ − 2(1 − cos φ))/(2φ⁴)`, `d′ = ((1 − cos φ)φ − 3(φ − sin φ))/(2φ⁵)`;
+/// Taylor series in `x` below `x = 0.01` (four terms: truncation < 1e-12 relative).
+fn t_coefficients<S: Real>(x: S) -> (S, S, S, S) {
+    if x < c(1e-2) {
+        let b = c::<S>(0.5) - x / c(24.0) + x * x / c(720.0) - x * x * x / c(40320.0);
+        let d = c::<S>(1.0 / 6.0) - x / c(120.0) + x * x / c(5040.0) - x * x * x / c(362880.0);
+        let db = c::<S>(-1.0 / 24.0) + x / c(360.0) - x * x / c(13440.0) + x * x * x / c(907200.0);
+        let dd =
+            c::<S>(-1.0 / 120.0) + x / c(2520.0) - x * x / c(120960.0) + x * x * x / c(9979200.0);
+        (b, d, db, dd)
+    } else {
+        let f = x.sqrt();
+        let (sn, cs) = (f.sin(), f.cos());
+        let x2 = x * x;
+        (
+            (S::one() - cs) / x,
+            (f - sn) / (x * f),
+            (f * sn - (S::one() - cs) * c(2.0)) / (x2 * c(2.0)),
+            ((S::one() - cs) * f - (f - sn) * c(3.0)) / (x2 * f * c(2.0)),
+        )
+    }
 }
 
 /// The log branch shift `2πk` of `φ` nearest to `prev`.
@@ -423,6 +446,39 @@ impl BeamP {
         (g.component_mul(&cn).dot(&g) + k.component_mul(&cm).dot(&k)) * c::<S>(0.5)
     }
 
+    /// Gradient of the energy density in its nine local numbers `(ψ, ψ_s, y_s)`, in closed
+    /// form (generic: differentiated once more by dual numbers for the tangent). With
+    /// `a = exp(ψ̃)ᵀ y_s`, `v = ψ_s`, `N = C_N(a − Γ⁰)`, `M = C_M(T(ψ) v − K⁰)`:
+    /// `∂e/∂y_s = exp(ψ̃) N`, `∂e/∂ψ_s = T(ψ)ᵀ M`,
+    /// `∂e/∂ψ = T(ψ)ᵀ (N × a) + (∂(T(ψ)v)/∂ψ)ᵀ M` (`δ exp(ψ̃)ᵀ = −(T δψ)~ exp(ψ̃)ᵀ`), and with
+    /// `T v = v − b ψ × v + d ψ × (ψ × v)` ([`t_coefficients`]):
+    /// `(∂(T v)/∂ψ)ᵀ M = −2b′ ((ψ×v)·M) ψ + b M × v + 2d′ ((ψ×(ψ×v))·M) ψ
+    ///  − d (M × (ψ × v) + (M × ψ) × v)`.
+    fn density_grad<S: Real>(&self, q: &Point, v: &[S; 9]) -> [S; 9] {
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        let (psi, dpsi, dy) = (at(0), at(3), at(6));
+        let e = rotation::exp(&psi);
+        let t = rotation::tangent(&psi);
+        let a = rotation::mtv(&e, &dy);
+        let cn: Vector3<S> = self.props.cn.map(c);
+        let cm: Vector3<S> = self.props.cm.map(c);
+        let nn = (a - q.gamma0.map(c::<S>)).component_mul(&cn);
+        let mm = (rotation::mv(&t, &dpsi) - q.kappa0.map(c::<S>)).component_mul(&cm);
+        let g_dy = rotation::mv(&e, &nn);
+        let g_dpsi = rotation::mtv(&t, &mm);
+        let (b, d, db, dd) = t_coefficients(psi.dot(&psi));
+        let pv = psi.cross(&dpsi);
+        let ppv = psi.cross(&pv);
+        let two = c::<S>(2.0);
+        let g_psi = rotation::mtv(&t, &nn.cross(&a)) - psi * (db * two * pv.dot(&mm))
+            + mm.cross(&dpsi) * b
+            + psi * (dd * two * ppv.dot(&mm))
+            - (mm.cross(&pv) + mm.cross(&psi).cross(&dpsi)) * d;
+        [
+            g_psi.x, g_psi.y, g_psi.z, g_dpsi.x, g_dpsi.y, g_dpsi.z, g_dy.x, g_dy.y, g_dy.z,
+        ]
+    }
+
     /// Strains `Γ`, `K` at the element's midpoint `ξ = 0`.
     pub fn strains(&self, nodes: &[NodeState]) -> (Vector3<f64>, Vector3<f64>) {
         SCRATCH.with(|s| {
@@ -454,30 +510,11 @@ impl BeamP {
             for g in sc.gz[..n].iter_mut() {
                 *g = [0.0; 6];
             }
-            let cn = self.props.cn;
-            let cm = self.props.cm;
             for q in &self.stiff {
                 let v = Self::point_vars(q, &sc.z[..n]);
-                let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
-                let (psi, dpsi, dy) = (at(0), at(3), at(6));
-                let e = rotation::exp(&psi);
-                let t = rotation::tangent(&psi);
-                let a = e.transpose() * dy;
-                let gamma = a - q.gamma0;
-                let kappa = t * dpsi - q.kappa0;
-                let nn = gamma.component_mul(&cn);
-                let mm = kappa.component_mul(&cm);
-                let g_dy = e * nn;
-                let g_dpsi = t.transpose() * mm;
-                // ∂e/∂ψ: dual numbers on ψ only.
-                let pd = Vector3::new(
-                    Dual::<3>::var(psi.x, 0),
-                    Dual::var(psi.y, 1),
-                    Dual::var(psi.z, 2),
-                );
-                let vars: [Dual<3>; 9] =
-                    std::array::from_fn(|k| if k < 3 { pd[k] } else { Dual::constant(v[k]) });
-                let g_psi = self.density(q, &vars).eps;
+                let at = |k: usize, v: &[f64; 9]| Vector3::new(v[k], v[k + 1], v[k + 2]);
+                let g = self.density_grad(q, &v);
+                let (g_psi, g_dpsi, g_dy) = (at(0, &g), at(3, &g), at(6, &g));
                 for i in (0..n).filter(|&i| i != m) {
                     for k in 0..3 {
                         sc.gz[i][k] += q.wj * q.ds[i] * g_dy[k];
@@ -511,7 +548,7 @@ impl BeamP {
     }
 
     /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
-    /// `tangent` their exact derivative into `out.tan` (second-order duals, module doc).
+    /// `tangent` their exact derivative into `out.tan` (module doc).
     fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
         if !tangent {
             return self.internal_forces(nodes, out);
@@ -524,21 +561,20 @@ impl BeamP {
             let m = self.refn;
             self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
             // Jacobians of the local numbers of every node but the reference, columns
-            // (xᵢ, θᵢ, xᵣ, θᵣ): y in closed form (see `internal_forces`), ψ and its Hessian in
-            // (θᵢ, θᵣ) by 6-direction second-order duals (ψ does not depend on positions).
+            // (xᵢ, θᵢ, xᵣ, θᵣ), in closed form (see `internal_forces`; ψ does not depend on positions).
             let sr = &nodes[self.nodes[m]];
             let lr = sr.r * self.lambda0[m];
             let l0r = &self.lambda0[m];
             for k in (0..n).filter(|&k| k != m) {
-                let st = &nodes[self.nodes[k]];
-                let (l0, sh) = (&self.lambda0[k], sc.shift[k]);
-                type H = Dual2SVec64<6>;
-                let th = Vector3::from_fn(|a, _| H::from_re(0.0).derivative(a));
-                let thr = Vector3::from_fn(|a, _| H::from_re(0.0).derivative(3 + a));
-                let zero = Vector3::from_element(H::from_re(0.0));
-                let psi = local_vars(&zero, &th, &zero, &thr, &st.r, &sr.r, l0, l0r, sh);
+                let l0 = &self.lambda0[k];
                 let z = &sc.z[k];
-                let y = Vector3::new(z[0], z[1], z[2]);
+                let (y, psi) = (
+                    Vector3::new(z[0], z[1], z[2]),
+                    Vector3::new(z[3], z[4], z[5]),
+                );
+                let ti = rotation::tangent_inv(&psi);
+                let dk = ti * l0.transpose();
+                let dr = -(ti * rotation::exp(&psi).transpose() * l0r.transpose());
                 let jac = &mut sc.jac[k];
                 *jac = SMatrix::zeros();
                 let yr = skew(&y) * l0r.transpose();
@@ -547,16 +583,9 @@ impl BeamP {
                         jac[(r, c)] = lr[(c, r)];
                         jac[(r, 6 + c)] = -lr[(c, r)];
                         jac[(r, 9 + c)] = yr[(r, c)];
+                        jac[(3 + r, 3 + c)] = dk[(r, c)];
+                        jac[(3 + r, 9 + c)] = dr[(r, c)];
                     }
-                }
-                for a in 0..3 {
-                    let o = &psi[3 + a];
-                    let g = o.v1.unwrap_generic(U1, Const::<6>);
-                    for c in 0..3 {
-                        jac[(3 + a, 3 + c)] = g[c];
-                        jac[(3 + a, 9 + c)] = g[3 + c];
-                    }
-                    sc.hess[k][a] = o.v2.unwrap_generic(Const::<6>, Const::<6>);
                 }
             }
             // Gradient (and Hessian) of Ũ in the local numbers.
@@ -568,11 +597,10 @@ impl BeamP {
             }
             for q in &self.stiff {
                 let v = Self::point_vars(q, &sc.z[..n]);
-                type H = Dual2SVec64<9>;
-                let vars: [H; 9] = std::array::from_fn(|k| H::from_re(v[k]).derivative(k));
-                let e = self.density(q, &vars);
-                let grad = e.v1.unwrap_generic(U1, Const::<9>);
-                let h = e.v2.unwrap_generic(Const::<9>, Const::<9>);
+                let vars: [Dual<9>; 9] = std::array::from_fn(|k| Dual::var(v[k], k));
+                let gd = self.density_grad(q, &vars);
+                let grad: [f64; 9] = std::array::from_fn(|k| gd[k].re);
+                let h = SMatrix::<f64, 9, 9>::from_fn(|r, c| gd[r].eps[c]);
                 for i in (0..n).filter(|&i| i != m) {
                     for a in 0..3 {
                         sc.gz[i][a] += q.wj * q.ds[i] * grad[6 + a];
@@ -647,13 +675,30 @@ impl BeamP {
             for k in (0..n).filter(|&k| k != m) {
                 let gz = &sc.gz[k];
                 let mut sec = SMatrix::<f64, 12, 12>::zeros();
-                for a in 0..3 {
-                    let h = &sc.hess[k][a];
-                    for r in 0..6 {
-                        for c in 0..6 {
-                            // 6-index (θᵢ 0..3, θᵣ 3..6) → 12-index (3..6, 9..12).
-                            let (rr, cc) = (r + 3 + 3 * (r / 3), c + 3 + 3 * (c / 3));
-                            sec[(rr, cc)] += gz[3 + a] * h[(r, c)];
+                // Σₐ g_ψₐ ∇²ψₐ in (θᵢ, θᵣ): the derivative at θ = 0 of the gradient of g_ψ·ψ in
+                // the additive chart, G(θ) = [T(θᵢ)ᵀ Λ⁰ᵢ T⁻ᵀ(ψ) g_ψ; −T(θᵣ)ᵀ Λ⁰ᵣ exp(ψ̃) T⁻ᵀ(ψ) g_ψ]
+                // (`R exp(θ̃ + δ̃) = R exp(θ̃) exp((T(θ)δ)~)`), by 6-direction dual numbers.
+                {
+                    type D = Dual<6>;
+                    let st = &nodes[self.nodes[k]];
+                    let (l0, sh) = (&self.lambda0[k], sc.shift[k]);
+                    let th = Vector3::from_fn(|a, _| D::var(0.0, a));
+                    let thr = Vector3::from_fn(|a, _| D::var(0.0, 3 + a));
+                    let zero = Vector3::from_element(D::constant(0.0));
+                    let lv = local_vars(&zero, &th, &zero, &thr, &st.r, &sr.r, l0, l0r, sh);
+                    let psi = Vector3::new(lv[3], lv[4], lv[5]);
+                    let gpsi: Vector3<D> = Vector3::new(gz[3], gz[4], gz[5]).map(D::constant);
+                    let w = rotation::mtv(&rotation::tangent_inv(&psi), &gpsi);
+                    let gk = rotation::mtv(&rotation::tangent(&th), &rotation::mv(&l0.map(c), &w));
+                    let gr = -rotation::mtv(
+                        &rotation::tangent(&thr),
+                        &rotation::mv(&l0r.map(c), &rotation::mv(&rotation::exp(&psi), &w)),
+                    );
+                    for r in 0..3 {
+                        for col in 0..6 {
+                            let cc = col + 3 + 3 * (col / 3);
+                            sec[(3 + r, cc)] += gk[r].eps[col];
+                            sec[(9 + r, cc)] += gr[r].eps[col];
                         }
                     }
                 }
