@@ -38,7 +38,8 @@ impl Default for PendulumSettings {
 /// from there along `d = (cos 30°, 0, sin 30°)`, joined to bar 1 by a universal joint (axis 1
 /// Z on bar 1, axis 2 Y on bar 2); 1 kg point masses at both tips; gravity along −Y; a
 /// triangular torque pulse `−1000 N·m × f(t)` about Z at node 2; a `CAME` contact of bar 2's
-/// tip with the floor `y = −1.8` (`k = 1e7 N/m`, `c = 1e3 N·s/m`). With `n` elements per
+/// tip with the floor `y = −1.8` (`k = 1e7 N/m`, `c = 1e3 N·s/m`, the paper's unclipped law
+/// eq. (17): `CLIP OFF`). With `n` elements per
 /// bar: nodes `2 … n+2` (bar 1, tip `n+2`), `n+3 … 2n+3` (bar 2, tip `2n+3`), floor node
 /// `2n+4`; elements: hinge 1, beams `2 … n+1`, ujoint `n+2`, beams `n+3 … 2n+2`, contact
 /// `2n+3`, masses `2n+4`, `2n+5`. For `n = 10` and the default settings this is
@@ -85,7 +86,7 @@ pub fn pendulum_deck(elements_per_bar: usize, s: &PendulumSettings) -> String {
     );
     let _ = writeln!(
         w,
-        "  {contact} CAME {floor} {tip2}  CAM LINE  FOLLOWER POINT  K 1e7  C 1e3"
+        "  {contact} CAME {floor} {tip2}  CAM LINE  FOLLOWER POINT  K 1e7  C 1e3  CLIP OFF"
     );
     let _ = writeln!(w, "  {m1} MASS {tip1} M 1\n  {m2} MASS {tip2} M 1\n");
     let _ = writeln!(

@@ -120,3 +120,94 @@ fn study_of_runs_that_stop_reports_them_and_writes_no_non_numbers() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The space–time study (`--refine 1,2,4,8 --steps 4e-4,2e-4,1e-4`) on a cantilever under a
+/// smooth tip force (`decks/cantilever_smooth_load.dat`, 4 → 32 elements). Two-node beams
+/// with one-point quadrature converge at order 2 in the element length (the element's
+/// bending error is (L_e²/12) × the curvature's second derivative, Taylor expansion of the
+/// midpoint rule), HHT at order 2 in the step; the load being smooth, the response is in
+/// the asymptotic range of both, where successive differences fall by 2² per halving to
+/// within the next term of the expansion (relative O(L_e²) and O((ωh)²), below 5 % here),
+/// so the observed orders must be 2 ± 0.1 in space (before the last pair, which has no
+/// successor) and 2 ± 0.2 in time (HHT's α = −0.1 adds an O(h) term of size α(ωh)² that
+/// is not yet negligible at the coarsest step). Every window's reference is then
+/// converged in both variables, every run is scored, and the files and diagram are written.
+#[test]
+fn space_time_study_separates_second_order_errors_in_space_and_time() {
+    let dir = std::env::temp_dir().join(format!("mecano_spacetime_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/cantilever_smooth_load.dat");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg("study")
+        .arg(&deck)
+        .args(["--refine", "1,2,4,8", "--steps", "4e-4,2e-4,1e-4"])
+        .args(["--nodes", "5", "--window", "0.05"])
+        .arg("-o")
+        .arg(&dir)
+        .output()
+        .expect("binary runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0));
+    for f in [
+        "spacetime.csv",
+        "spacetime_windows.csv",
+        "spacetime_ladders.csv",
+        "table.txt",
+        "work_precision.svg",
+        "work_precision.png",
+    ] {
+        let len = std::fs::metadata(dir.join(f)).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 0, "{f} missing or empty");
+    }
+    let mut rd = csv::Reader::from_path(dir.join("spacetime_ladders.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    let mut space_orders = Vec::new();
+    let mut time_orders = Vec::new();
+    for r in &rows {
+        assert_eq!(&r[5], "true", "every window converged: {r:?}");
+        if let Ok(p) = r[4].parse::<f64>() {
+            match &r[0] {
+                "space" => space_orders.push(p),
+                _ => time_orders.push(p),
+            }
+        }
+    }
+    // 4 meshes: orders of levels 1 and 2 (2 windows each); 3 steps: level 1.
+    assert_eq!(space_orders.len(), 4, "{space_orders:?}");
+    assert_eq!(time_orders.len(), 2, "{time_orders:?}");
+    for p in &space_orders {
+        assert!((p - 2.0).abs() <= 0.1, "space orders {space_orders:?}");
+    }
+    for p in &time_orders {
+        assert!((p - 2.0).abs() <= 0.2, "time orders {time_orders:?}");
+    }
+    let mut rd = csv::Reader::from_path(dir.join("spacetime.csv")).unwrap();
+    let runs: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    assert_eq!(runs.len(), 12);
+    // Every run but the reference is scored, and the coarsest mesh's error is its space
+    // error (the time error is 100 times smaller here).
+    let errs: Vec<f64> = runs.iter().map(|r| r[8].parse().unwrap()).collect();
+    assert_eq!(errs[11], 0.0);
+    assert!(errs[..11].iter().all(|e| *e > 0.0));
+    assert!(runs.iter().any(|r| &r[9] == "true"), "a frontier");
+    // Two meshes cannot judge convergence in space: bad input, exit code 2.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg("study")
+        .arg(&deck)
+        .args([
+            "--refine",
+            "1,2",
+            "--steps",
+            "4e-4,2e-4,1e-4",
+            "--nodes",
+            "5",
+        ])
+        .arg("-o")
+        .arg(&dir)
+        .output()
+        .expect("binary runs");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at least three meshes"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,159 @@
+//! `mecano-rs study DECK`: the command line.
+
+use super::*;
+use crate::deck::load_deck;
+use crate::model::Analysis;
+use std::io::Write;
+
+/// `mecano-rs study DECK`: arguments.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StudyArgs {
+    /// The deck to study (a dynamic analysis).
+    pub deck: PathBuf,
+    /// Fixed time steps, s, comma-separated (default: the deck's step ×8, ×4, ×2, ×1, ÷2).
+    #[arg(long, value_delimiter = ',')]
+    pub steps: Vec<f64>,
+    /// Adaptive runs: position tolerances, m, comma-separated (rotation tolerance: the same
+    /// number in rad).
+    #[arg(long, value_delimiter = ',')]
+    pub adaptive: Vec<f64>,
+    /// HHT α values of the fixed-step runs, comma-separated (default: the deck's).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub alpha: Vec<f64>,
+    /// Nodes whose histories are compared (default: the deck's OUTPUT nodes).
+    #[arg(long, value_delimiter = ',')]
+    pub nodes: Vec<u32>,
+    /// Window length for the errors, s.
+    #[arg(long, default_value_t = 0.25)]
+    pub window: f64,
+    /// A window whose two finest runs differ by at most this (m, and rad for rotations)
+    /// counts as converged.
+    #[arg(long, default_value_t = 1e-6)]
+    pub floor: f64,
+    /// Study only up to this time, s (default: the deck's end time).
+    #[arg(long)]
+    pub until: Option<f64>,
+    /// Output directory (default: out/<deck name>/study).
+    #[arg(short = 'o', long = "out")]
+    pub out: Option<PathBuf>,
+    /// Mesh refinement factors, comma-separated (every beam divided into k times its
+    /// elements). One factor: the time study on that mesh. Three or more (e.g. 1,2,4): the
+    /// space–time study, every (mesh, step) pair run, the finest of both the reference.
+    #[arg(long, value_delimiter = ',')]
+    pub refine: Vec<u32>,
+}
+
+/// Runs `mecano-rs study` and returns the exit code (0, or 2 for bad input).
+pub fn run(args: &StudyArgs) -> u8 {
+    let model = match load_deck(&args.deck) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("{:?}", miette::Report::new(e));
+            return crate::app::EXIT_BAD_INPUT;
+        }
+    };
+    let Analysis::Dynamic { step, .. } = model.analysis else {
+        eprintln!(
+            "error: {}: a study needs ANALYSIS DYNAMIC",
+            args.deck.display()
+        );
+        return crate::app::EXIT_BAD_INPUT;
+    };
+    let steps = if args.steps.is_empty() {
+        [8.0, 4.0, 2.0, 1.0, 0.5].iter().map(|k| step * k).collect()
+    } else {
+        args.steps.clone()
+    };
+    let nodes = if !args.nodes.is_empty() {
+        args.nodes.clone()
+    } else {
+        match &model.output.nodes {
+            crate::model::Selection::List(l) => l.iter().map(|n| n.0).collect(),
+            _ => model.nodes.keys().map(|n| n.0).collect(),
+        }
+    };
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| crate::app::default_out_dir(&args.deck, &model).join("study"));
+    if args.refine.len() > 1 {
+        return run_space(args, steps, nodes, out_dir);
+    }
+    let opts = StudyOptions {
+        steps,
+        adaptive: args.adaptive.clone(),
+        alphas: args.alpha.clone(),
+        nodes,
+        window: args.window,
+        floor: args.floor,
+        t_max: args.until,
+        out_dir: out_dir.clone(),
+        refine: args.refine.first().copied().unwrap_or(1),
+    };
+    let report = match run_study(&args.deck, &opts, |s| eprintln!("{s}")) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {}: {e}", args.deck.display());
+            return crate::app::EXIT_BAD_INPUT;
+        }
+    };
+    let _ = print_table(&report, &mut io::stdout().lock());
+    for ext in ["svg", "png"] {
+        let file = out_dir.join(format!("work_precision.{ext}"));
+        if let Err(e) = draw_work_precision(&report, &file) {
+            eprintln!("error: {}: {e}", file.display());
+            return crate::app::EXIT_FAILED;
+        }
+    }
+    println!(
+        "written: {}/study.csv, study_windows.csv, work_precision.svg/.png",
+        out_dir.display()
+    );
+    crate::app::EXIT_OK
+}
+
+/// The space–time study (`--refine` with several factors).
+fn run_space(args: &StudyArgs, steps: Vec<f64>, nodes: Vec<u32>, out_dir: PathBuf) -> u8 {
+    if !args.adaptive.is_empty() || args.alpha.len() > 1 {
+        eprintln!(
+            "error: {}: a space-time study (several --refine factors) runs fixed steps at the deck's alpha: drop --adaptive and --alpha",
+            args.deck.display()
+        );
+        return crate::app::EXIT_BAD_INPUT;
+    }
+    let opts = space::SpaceTimeOptions {
+        refine: args.refine.clone(),
+        steps,
+        nodes,
+        window: args.window,
+        floor: args.floor,
+        t_max: args.until,
+        out_dir: out_dir.clone(),
+    };
+    let report = match space::run_space_time(&args.deck, &opts, |s| eprintln!("{s}")) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {}: {e}", args.deck.display());
+            return crate::app::EXIT_BAD_INPUT;
+        }
+    };
+    let mut table = Vec::new();
+    let _ = space::print_space_time(&report, &mut table);
+    let _ = io::stdout().write_all(&table);
+    if let Err(e) = std::fs::write(out_dir.join("table.txt"), &table) {
+        eprintln!("error: {}: {e}", out_dir.join("table.txt").display());
+        return crate::app::EXIT_FAILED;
+    }
+    for ext in ["svg", "png"] {
+        let file = out_dir.join(format!("work_precision.{ext}"));
+        if let Err(e) = space::draw_space_time(&report, &file) {
+            eprintln!("error: {}: {e}", file.display());
+            return crate::app::EXIT_FAILED;
+        }
+    }
+    println!(
+        "written: {}/spacetime.csv, spacetime_windows.csv, spacetime_ladders.csv, table.txt, work_precision.svg/.png",
+        out_dir.display()
+    );
+    crate::app::EXIT_OK
+}
