@@ -14,6 +14,7 @@ pub mod deck;
 pub mod dual;
 pub mod elements;
 pub mod interrupt;
+pub mod lagrange;
 pub mod model;
 pub mod output;
 pub mod plot;

@@ -110,6 +110,61 @@ pub fn pendulum_deck(elements_per_bar: usize, s: &PendulumSettings) -> String {
     d
 }
 
+/// The seed scene with each bar ONE BEAM card of `ORDER order` divided in `divide` elements
+/// (`order · divide + 1` nodes per bar), with the numbers of `decks/pendulum.dat`: user
+/// nodes 1, 2, 12 (bar 1's tip), 13, 23 (bar 2's tip), 24 (floor); elements hinge 1, bar 1
+/// (2), ujoint 12, bar 2 (13), contact 23, masses 24 and 25. The generated nodes are
+/// numbered from 25 on. `(10, 1)` is `decks/pendulum.dat`'s mesh with other numbers.
+pub fn pendulum_order_deck(divide: u32, order: u32, s: &PendulumSettings) -> String {
+    let (cx, cz) = (1.0 + 0.75f64.sqrt(), 0.5);
+    let mut d = String::new();
+    let w = &mut d;
+    let _ = writeln!(
+        w,
+        "TITLE double pendulum striking the floor - {divide} elements of order {order} per bar (E = {:e})\n",
+        s.young
+    );
+    let _ = writeln!(w, "MATERIALS\n  1  E {:e}  NU 0.3  RHO 7800\n", s.young);
+    let _ = writeln!(
+        w,
+        "SECTIONS\n  1  A 9e-4  I2 8.3e-8  I3 8.3e-8  J 4.15e-8  K 0.8333333333333334\n"
+    );
+    let _ = writeln!(
+        w,
+        "NODES\n  1   0 0 0  FIX ALL\n  2   0 0 0\n  12  1 0 0\n  13  1 0 0"
+    );
+    let _ = writeln!(w, "  23  {cx:?} 0 {cz:?}\n  24  0 -1.8 0  FIX ALL\n");
+    let _ = writeln!(w, "FUNCTIONS\n  1 TABLE  0 0  0.01 1  0.02 0\n");
+    let _ = writeln!(w, "ELEMENTS\n  1  HINGE 1 2  AXIS 0 0 1");
+    let _ = writeln!(
+        w,
+        "  2  BEAM 2 12  MAT 1 SEC 1 DIVIDE {divide} ORDER {order}"
+    );
+    let _ = writeln!(w, "  12 UJOINT 12 13  AXIS1 0 0 1  AXIS2 0 1 0");
+    let _ = writeln!(
+        w,
+        "  13 BEAM 13 23  MAT 1 SEC 1 DIVIDE {divide} ORDER {order}"
+    );
+    let _ = writeln!(w, "  23 CAME 24 23  CAM LINE  FOLLOWER POINT  K 1e7  C 1e3");
+    let _ = writeln!(w, "  24 MASS 12 M 1\n  25 MASS 23 M 1\n");
+    let _ = writeln!(
+        w,
+        "LOADS\n  GRAVITY 0 -9.81 0\n  MOMENT 2  0 0 -1000  FUNCTION 1\n"
+    );
+    let _ = writeln!(
+        w,
+        "ANALYSIS DYNAMIC ALPHA {:?} STEP {:e} END {:?}\n",
+        s.alpha, s.step, s.end
+    );
+    if s.output {
+        let _ = writeln!(w, "OUTPUT NODES 2 12 23 ELEMENTS 1 12 23 EVERY 10");
+    } else {
+        let _ = writeln!(w, "OUTPUT NODES NONE ELEMENTS NONE");
+    }
+    let _ = writeln!(w, "END");
+    d
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,6 +201,22 @@ mod tests {
             .expect("parses");
             assert_eq!(m.nodes.len(), 2 * n + 4);
             assert_eq!(m.elements.len(), 2 * n + 5);
+        }
+        // Ten two-node beams per bar as one card each: the same model as the seed's up to
+        // the numbering of the interior nodes (same positions, same counts).
+        let m = crate::deck::parse_deck(
+            &pendulum_order_deck(10, 1, &PendulumSettings::default()),
+            "generated",
+        )
+        .expect("parses");
+        assert_eq!(m.nodes.len(), seed.nodes.len());
+        for (d, p) in [(1, 8), (2, 4), (3, 5)] {
+            let m = crate::deck::parse_deck(
+                &pendulum_order_deck(d, p, &PendulumSettings::default()),
+                "generated",
+            )
+            .expect("parses");
+            assert_eq!(m.nodes.len() as u32, 4 + 2 * d * p);
         }
     }
 }

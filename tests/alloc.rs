@@ -106,3 +106,24 @@ fn writing_every_node_and_element_every_step_does_not_allocate() {
     assert!(ok, "a step failed");
     assert_eq!(n, 0, "{n} heap allocations in 50 steps with their output");
 }
+
+/// The step loop of beams of order p allocates nothing either (the element's scratch
+/// buffers are grown once per thread): the seed scene with two elements of order 6 per bar.
+#[test]
+fn the_step_loop_of_high_order_beams_does_not_allocate() {
+    let s = mecano::scenes::PendulumSettings {
+        output: false,
+        ..Default::default()
+    };
+    let deck = mecano::scenes::pendulum_order_deck(2, 6, &s);
+    let model = mecano::deck::parse_deck(&deck, "pendulum_p6.dat").expect("deck");
+    let mut integ = mecano::solver::prepare(&model).expect("prepare");
+    integ.initialize().expect("initial accelerations");
+    let h = 1e-4;
+    for _ in 0..5 {
+        integ.try_step(h).expect("step");
+    }
+    let (ok, n) = allocations_in(|| (0..50).all(|_| integ.try_step(h).is_ok()));
+    assert!(ok, "a step failed");
+    assert_eq!(n, 0, "{n} heap allocations in 50 steps");
+}

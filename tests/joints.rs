@@ -362,7 +362,7 @@ fn four_bar_redundant_hinges_are_named() {
     let model = deck("four_bar.dat");
     let integ = solver::prepare(&model).expect("builds");
     let msg =
-        mecano::elements::joints::redundancy_error(&integ.sys, &integ.nodes).expect("redundant");
+        mecano::solver::redundancy::redundancy_error(&integ.sys, &integ.nodes).expect("redundant");
     println!("{msg}");
     assert!(msg.contains("element 7 (equation 3, 4, 5)"), "{msg}");
     assert!(
@@ -395,7 +395,7 @@ fn well_posed_mechanisms_have_no_redundant_constraints() {
         let model = deck(d);
         let integ = solver::prepare(&model).expect("builds");
         assert_eq!(
-            mecano::elements::joints::redundancy_error(&integ.sys, &integ.nodes),
+            mecano::solver::redundancy::redundancy_error(&integ.sys, &integ.nodes),
             None,
             "{d}"
         );

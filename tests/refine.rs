@@ -296,14 +296,14 @@ fn command_line_refine_check_run_and_outputs() {
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
-/// `decks/pendulum_converged.dat` is the seed deck with every beam divided into 8 (DIVIDE 8
+/// `decks/pendulum_converged_beams.dat` is the seed deck with every beam divided into 8 (DIVIDE 8
 /// on both bars' cards): the same model as `--refine 8` of `decks/pendulum.dat`, up to the
 /// title, the step, the end time and the output sampling.
 #[test]
 fn the_converged_deck_is_the_seed_deck_refined_by_8() {
     let mut seed = pendulum();
     seed.refine(8).expect("refines");
-    let mut conv = load_deck(&deck_path("pendulum_converged.dat")).expect("parses");
+    let mut conv = load_deck(&deck_path("pendulum_converged_beams.dat")).expect("parses");
     assert_eq!(conv.generated_counts(), (140, 140));
     assert!(seed.set_fixed_step(2e-5, 1.5, None));
     seed.title = conv.title.clone();

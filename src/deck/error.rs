@@ -185,6 +185,14 @@ pub enum DeckErrorKind {
         /// Second node.
         second: u32,
     },
+    /// A BEAM's ARC that does not make a circular arc with its end nodes.
+    #[error("ARC of BEAM element {element}: {reason}")]
+    BadArc {
+        /// Element number.
+        element: u32,
+        /// What is wrong with the three points.
+        reason: String,
+    },
     /// A zero or non-finite direction vector.
     #[error("{what} must be a non-zero finite vector, found ({x}, {y}, {z})")]
     BadAxis {
@@ -347,7 +355,9 @@ impl DeckError {
             K::Duplicate { .. } => "mecano::deck::duplicate",
             K::Undefined { .. } => "mecano::deck::undefined",
             K::BadGeneration { .. } => "mecano::deck::generation",
-            K::BeamSameNode { .. } | K::BeamZeroLength { .. } => "mecano::deck::beam",
+            K::BeamSameNode { .. } | K::BeamZeroLength { .. } | K::BadArc { .. } => {
+                "mecano::deck::beam"
+            }
             K::BadAxis { .. }
             | K::Axis2Parallel { .. }
             | K::PlaneParallel

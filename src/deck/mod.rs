@@ -153,13 +153,27 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw("RY", "NODES", "rotation about global Y"),
     kw("RZ", "NODES", "rotation about global Z"),
     // elements
-    kw("BEAM", "ELEMENTS", "geometrically exact two-node beam"),
+    kw(
+        "BEAM",
+        "ELEMENTS",
+        "geometrically exact beam (two nodes, or p + 1 with ORDER)",
+    ),
     kw("MAT", "ELEMENTS", "material number of a BEAM"),
     kw("SEC", "ELEMENTS", "section number of a BEAM"),
     kw(
         "DIVIDE",
         "ELEMENTS",
         "BEAM: divide into n equal elements, nodes generated on the axis",
+    ),
+    kw(
+        "ORDER",
+        "ELEMENTS",
+        "BEAM: polynomial order p, p - 1 nodes generated at the GLL points",
+    ),
+    kw(
+        "ARC",
+        "ELEMENTS",
+        "BEAM: centre of the circular arc that is the reference axis",
     ),
     kw(
         "AXIS2",

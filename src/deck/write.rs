@@ -72,12 +72,13 @@ fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
 /// back (spans aside) for every model `parse_deck` can produce.
 pub fn write_deck(model: &Model) -> String {
     let mut s = String::new();
-    // Generated nodes and elements (DIVIDE) are not written: the BEAM card's DIVIDE
-    // regenerates them with the same numbers.
+    // Generated nodes and elements (DIVIDE, ORDER) are not written: the BEAM card's DIVIDE
+    // and ORDER regenerate them with the same numbers.
     let gen_nodes: HashSet<NodeId> = model
         .divisions
         .values()
         .flat_map(|d| d.interior.iter().copied())
+        .chain(model.order_nodes.values().flatten().copied())
         .collect();
     let gen_elements: HashSet<ElementId> = model
         .divisions
@@ -163,6 +164,13 @@ pub fn write_deck(model: &Model) -> String {
             let division = model.divisions.get(&e.id);
             let nodes: Vec<String> = match division {
                 Some(d) => d.ends.iter().map(|n| n.0.to_string()).collect(),
+                // A beam of order p lists its interior nodes between its ends.
+                None if matches!(e.kind, ElementKind::Beam { .. }) && e.nodes.len() > 2 => {
+                    [e.nodes[0], e.nodes[e.nodes.len() - 1]]
+                        .iter()
+                        .map(|n| n.0.to_string())
+                        .collect()
+                }
                 None => e.nodes.iter().map(|n| n.0.to_string()).collect(),
             };
             let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
@@ -171,6 +179,8 @@ pub fn write_deck(model: &Model) -> String {
                     material,
                     section,
                     axis2,
+                    order,
+                    arc,
                 } => {
                     let _ = write!(s, " MAT {} SEC {}", material.0, section.0);
                     if let Some(a) = axis2 {
@@ -178,6 +188,12 @@ pub fn write_deck(model: &Model) -> String {
                     }
                     if let Some(d) = division {
                         let _ = write!(s, " DIVIDE {}", d.count());
+                    }
+                    if *order > 1 {
+                        let _ = write!(s, " ORDER {order}");
+                    }
+                    if let Some(c) = arc {
+                        let _ = write!(s, " ARC {}", v3(c));
                     }
                 }
                 ElementKind::Mass { mass, inertia } => {

@@ -16,6 +16,7 @@
 //! `[δx, δΘ]`, velocities and accelerations), the coefficients coming from the integrator.
 
 pub mod beam;
+pub mod beam_p;
 pub mod came;
 pub mod joints;
 pub mod mass;
@@ -56,12 +57,10 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
             ElementKind::Beam {
                 material,
                 section,
-                axis2,
+                order,
+                ..
             } => {
-                let mat = &model.materials[material];
-                let sec = &model.sections[section];
-                let (a, b) = (idx(&el.nodes[0]), idx(&el.nodes[1]));
-                let (x1, x2) = (model.nodes[a].position, model.nodes[b].position);
+                let (mat, sec) = (&model.materials[material], &model.sections[section]);
                 if sec.rigid {
                     unsupported.push(format!("{} (BEAM with a RIGID section)", el.id));
                     continue;
@@ -70,28 +69,21 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     unsupported.push(format!("{} (material DAMPING)", el.id));
                     continue;
                 }
-                let props = beam::BeamProperties {
-                    cn: Vector3::new(
-                        mat.young * sec.area,
-                        sec.shear_factor * mat.shear * sec.area,
-                        sec.shear_factor * mat.shear * sec.area,
-                    ),
-                    cm: Vector3::new(
-                        mat.shear * sec.torsion,
-                        mat.young * sec.i2,
-                        mat.young * sec.i3,
-                    ),
-                    mass: mat.density * sec.area,
-                    inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
-                };
-                out.push(Box::new(beam::Beam::new(
-                    el.id,
-                    [a, b],
-                    &x1,
-                    &x2,
-                    *axis2,
-                    props,
-                )));
+                let nodes: Vec<usize> = el.nodes.iter().map(idx).collect();
+                if *order as usize > beam_p::MAX_ORDER
+                    || (nodes.len() != 2 && nodes.len() != *order as usize + 1)
+                {
+                    return Err(BuildError::Invalid {
+                        element: el.id,
+                        message: format!(
+                            "a beam of order {order} (at most {}) needs 2 or {} nodes, it has {}",
+                            beam_p::MAX_ORDER,
+                            order + 1,
+                            nodes.len()
+                        ),
+                    });
+                }
+                out.push(beam_p::from_model(model, el, nodes));
             }
             ElementKind::Mass { mass, inertia } => {
                 out.push(Box::new(mass::PointMass::new(

@@ -57,6 +57,9 @@ pub enum MeshError {
     /// The element to divide is not a two-node beam of the model.
     #[error("{0} is not a beam of the model")]
     NotABeam(ElementId),
+    /// The end nodes and the centre of a beam's `ARC` do not make an arc.
+    #[error("{0}: ARC: {1}")]
+    Arc(ElementId, super::arc::ArcError),
     /// A parametric position outside (0, 1).
     #[error("parametric position {0} is not inside (0, 1)")]
     BadParameter(f64),
@@ -283,6 +286,8 @@ impl Model {
         if k == 1 {
             return Ok(());
         }
+        // Beams of order p are divided as two-node beams, then raised again (order.rs).
+        self.lower_orders();
         let old = self.undivide();
         let counts: IndexMap<ElementId, u32> = self
             .elements
@@ -295,7 +300,8 @@ impl Model {
                     .ok_or(MeshError::Overflow { what: "element" })
             })
             .collect::<Result<_, _>>()?;
-        self.divide_beams(&counts)
+        self.divide_beams(&counts)?;
+        self.raise_orders(&mut Numbering::after(self))
     }
 
     /// Numbers of the generated nodes and elements: (nodes, elements).

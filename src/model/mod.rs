@@ -6,8 +6,10 @@
 //!
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
+pub mod arc;
 mod ids;
 mod mesh;
+pub mod order;
 mod summary;
 
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
@@ -221,7 +223,8 @@ pub struct CameData {
 /// What an element is, with its type-specific data.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ElementKind {
-    /// Geometrically exact two-node beam.
+    /// Geometrically exact beam of order `order` (`order + 1` nodes along the axis: the
+    /// two ends the user named and, for `order > 1`, generated interior nodes).
     Beam {
         /// Material.
         material: MaterialId,
@@ -230,6 +233,10 @@ pub enum ElementKind {
         /// Direction of the section's local axis 2 in the reference configuration
         /// (global); `None` = the documented default.
         axis2: Option<Vector3<f64>>,
+        /// Polynomial order `p ≥ 1` (`ORDER p`; 1 = the two-node beam).
+        order: u32,
+        /// Centre of the circular arc that is the reference axis (`ARC`); `None` = straight.
+        arc: Option<Vector3<f64>>,
     },
     /// A point mass with optional rotary inertia (global frame at t = 0).
     Mass {
@@ -503,6 +510,9 @@ pub struct Model {
     /// Deck parameters (`PARAMETERS`), name → value in force (the deck's value or an
     /// override), in deck order. The fields that use them already hold their values.
     pub parameters: IndexMap<String, f64>,
+    /// The interior nodes generated for beams of order > 1 (`ORDER p`), by element, along
+    /// the axis (see [`order`](self::order)).
+    pub order_nodes: IndexMap<ElementId, Vec<NodeId>>,
 }
 
 #[cfg(test)]

@@ -233,7 +233,7 @@ impl Integrator {
         // An over-constrained mechanism makes every iteration matrix singular: stop at
         // once, naming the redundant joints.
         if n > nn
-            && let Some(msg) = crate::elements::joints::redundancy_error(&self.sys, &self.nodes)
+            && let Some(msg) = super::redundancy::redundancy_error(&self.sys, &self.nodes)
         {
             return Err(self.failure(
                 0.0,
@@ -666,11 +666,10 @@ impl Integrator {
                 self.lu_step = f64::NAN;
                 if let Err(e) = self.sys.matrix.factor() {
                     self.stats.factorizations += 1;
-                    let why =
-                        match crate::elements::joints::redundancy_error(&self.sys, &self.trial) {
-                            Some(r) => format!("{e}; {r}"),
-                            None => e.to_string(),
-                        };
+                    let why = match super::redundancy::redundancy_error(&self.sys, &self.trial) {
+                        Some(r) => format!("{e}; {r}"),
+                        None => e.to_string(),
+                    };
                     return Err(self.failure(h, FailureReason::Singular(why), history, fref));
                 }
                 self.stats.factorizations += 1;

@@ -7,6 +7,7 @@
 pub mod integrator;
 pub mod linear;
 pub mod state;
+pub mod redundancy;
 pub mod system;
 
 pub use integrator::{HhtParams, Integrator, StepInfo};

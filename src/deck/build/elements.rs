@@ -2,6 +2,7 @@
 
 use super::cursor::*;
 use super::*;
+use crate::model::order::MAX_ORDER;
 
 impl Builder<'_> {
     // ---------------------------------------------------------------- ELEMENTS
@@ -56,7 +57,8 @@ impl Builder<'_> {
                 let n2 = c.uint("second node number")?;
                 let mut seen = Seen::default();
                 let (mut mat, mut sec, mut axis2, mut divide) = (None, None, None, None);
-                const KW: [&str; 4] = ["MAT", "SEC", "AXIS2", "DIVIDE"];
+                let (mut order, mut arc) = (1, None);
+                const KW: [&str; 6] = ["MAT", "SEC", "AXIS2", "DIVIDE", "ORDER", "ARC"];
                 while let Some(t) = c.peek() {
                     let Some((kw, ks)) = c.keyword(&KW) else {
                         return Err(c.unexpected(t, &expected_list(&KW)));
@@ -74,6 +76,20 @@ impl Builder<'_> {
                                 return Err(out_of_range("DIVIDE", text, &range, ns));
                             }
                             divide = Some(n);
+                        }
+                        "ORDER" => {
+                            let t = c.peek();
+                            let (p, ps) = c.uint("ORDER (polynomial order of the beam)")?;
+                            if p == 0 || p > MAX_ORDER {
+                                let text = t.map_or("", |t| t.text);
+                                let range = format!("1 to {MAX_ORDER}");
+                                return Err(out_of_range("ORDER", text, &range, ps));
+                            }
+                            order = p;
+                        }
+                        "ARC" => {
+                            let (v, s, _) = c.vec3("ARC (centre of the arc)")?;
+                            arc = Some((v, s));
                         }
                         _ => axis2 = Some(c.axis("AXIS2")?),
                     }
@@ -116,7 +132,7 @@ impl Builder<'_> {
                     (n1, n2),
                     (MaterialId(mat), SectionId(sec)),
                     axis2.map(|(u, _, s)| (u, s)),
-                    divide.unwrap_or(1),
+                    (divide.unwrap_or(1), order, arc),
                     span,
                     id_span,
                 );
@@ -250,7 +266,7 @@ impl Builder<'_> {
         ((n1, s1), (n2, s2)): ((u32, Span), (u32, Span)),
         (material, section): (MaterialId, SectionId),
         axis2: Option<(Vector3<f64>, Span)>,
-        divide: u32,
+        (divide, order, arc): (u32, u32, Option<(Vector3<f64>, Span)>),
         span: Span,
         id_span: Span,
     ) -> R<()> {
@@ -299,6 +315,25 @@ impl Builder<'_> {
             {
                 return Err(DeckError::new(K::Axis2Parallel { element: id }, axs));
             }
+            if let Some((centre, cs)) = arc {
+                let reason = match crate::model::arc::Arc::new(&pa, &pb, &centre) {
+                    Err(e) => Some(e.to_string()),
+                    // AXIS2 must cross the arc everywhere.
+                    Ok(a) if axis2.is_some_and(|(ax, _)| a.meets_tangent(&ax)) => {
+                        Some("AXIS2 is parallel to the arc's tangent somewhere on it".to_string())
+                    }
+                    Ok(_) => None,
+                };
+                if let Some(reason) = reason {
+                    return Err(DeckError::new(
+                        K::BadArc {
+                            element: id,
+                            reason,
+                        },
+                        cs,
+                    ));
+                }
+            }
             self.add_element(
                 id,
                 vec![na, nb],
@@ -306,6 +341,8 @@ impl Builder<'_> {
                     material,
                     section,
                     axis2: axis2.map(|a| a.0),
+                    order,
+                    arc: arc.map(|a| a.0),
                 },
                 span,
                 id_span,

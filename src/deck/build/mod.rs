@@ -217,6 +217,7 @@ pub(crate) fn build_model(
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
         parameters,
+        order_nodes: IndexMap::new(),
     };
     // Generated numbers start past every user number: divide once all are known.
     let mut numbering = crate::model::Numbering::after(&model);
@@ -233,6 +234,19 @@ pub(crate) fn build_model(
             );
             return Err(vec![err]);
         }
+    }
+    // Interior nodes of beams of ORDER p, after the divisions' (model/order.rs). The arcs
+    // were validated card by card: this cannot fail on a parsed deck, but says so if it does.
+    if let Err(e) = model.raise_orders(&mut numbering) {
+        let err = DeckError::new(
+            K::BadGeneration {
+                first: 0,
+                last: 0,
+                reason: e.to_string(),
+            },
+            Span::default(),
+        );
+        return Err(vec![err]);
     }
     Ok(model)
 }

@@ -1,0 +1,85 @@
+//! Cost of the seed scene's step against the polynomial order of the beams
+//! (`cargo bench --bench order`): the residual assembly (every Newton iteration), the
+//! assembly with the iteration matrix (at each factorisation) and one whole HHT step, for the
+//! scene built by [`mecano::scenes::pendulum_order_deck`] with each bar `d` elements of order
+//! `p`: `p` = 1, 2, 4, 8 at (about) 17 nodes per bar, and `p` = 4, 8 with `d` = 1, 2, 4 (the
+//! cost at a fixed order must grow at most linearly with the nodes).
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use mecano::elements::EvalContext;
+use mecano::scenes::{PendulumSettings, pendulum_order_deck};
+use mecano::solver::Integrator;
+use std::hint::black_box;
+
+const H: f64 = 1e-4;
+
+/// (divide, order) pairs: equal node counts across orders, then growing meshes per order.
+const MESHES: [(u32, u32); 8] = [
+    (16, 1),
+    (8, 2),
+    (4, 4),
+    (2, 8),
+    (1, 4),
+    (2, 4),
+    (1, 8),
+    (4, 8),
+];
+
+fn advanced(divide: u32, order: u32, steps: usize) -> Integrator {
+    let s = PendulumSettings {
+        output: false,
+        ..Default::default()
+    };
+    let deck = pendulum_order_deck(divide, order, &s);
+    let model = mecano::deck::parse_deck(&deck, "pendulum").expect("generated deck");
+    let mut integ = mecano::solver::prepare(&model).expect("prepare");
+    integ.initialize().expect("initialize");
+    for _ in 0..steps {
+        integ.try_step(H).expect("step");
+    }
+    integ
+}
+
+fn step_context(integ: &Integrator, h: f64) -> EvalContext {
+    let p = integ.hht;
+    EvalContext {
+        c_v: p.gamma / (p.beta * h),
+        c_a: 1.0 / ((1.0 - p.alpha_f) * p.beta * h * h),
+        h,
+        t: integ.t + h,
+        ..integ.current_context()
+    }
+}
+
+fn id(d: u32, p: u32) -> BenchmarkId {
+    BenchmarkId::from_parameter(format!("p{p}_d{d}_nodes{}", d * p + 1))
+}
+
+fn assembly(c: &mut Criterion) {
+    for (name, tangent) in [("residual", false), ("residual_and_matrix", true)] {
+        let mut g = c.benchmark_group(format!("order_{name}"));
+        for (d, p) in MESHES {
+            let mut integ = advanced(d, p, 100);
+            let ctx = step_context(&integ, H);
+            let (nodes, lambda) = (integ.nodes.clone(), integ.lambda.clone());
+            g.bench_function(id(d, p), |b| {
+                b.iter(|| black_box(integ.sys.assemble(&ctx, &nodes, &lambda, tangent)))
+            });
+        }
+        g.finish();
+    }
+}
+
+fn step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("order_step");
+    for (d, p) in MESHES {
+        let mut integ = advanced(d, p, 100);
+        g.bench_function(id(d, p), |b| {
+            b.iter(|| black_box(integ.try_step(H).expect("step")))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, step);
+criterion_main!(benches);

@@ -1,0 +1,857 @@
+//! The geometrically exact beam of order `p` (Legendre spectral element, `p + 1` nodes).
+//!
+//! # Kinematics (objective; Crisfield & Jelenić 1999, eqs. 9–12; Jelenić & Crisfield 1999)
+//! Node `i` at parametric position `ξᵢ ∈ [−1, 1]` (the Gauss–Lobatto–Legendre points for a
+//! deck's `ORDER p`, [`crate::lagrange::gll`]) carries its position `xᵢ` and the triad
+//! `Λᵢ = Rᵢ Λ⁰ᵢ` (`Λ⁰ᵢ`: the reference triad at the node, axis 1 along the reference axis).
+//! With the **reference node** `r = ⌊p/2⌋` (for `p = 1` the first node) the element works in
+//! local variables that a rigid motion leaves unchanged:
+//! `yᵢ = Λᵣᵀ (xᵢ − xᵣ)`, `ψᵢ = log(Λᵣᵀ Λᵢ)` (the *relative* rotations).
+//! Both are Lagrange-interpolated, `y(ξ) = Σ Nᵢ(ξ) yᵢ`, `ψ(ξ) = Σ Nᵢ(ξ) ψᵢ`, and the triad
+//! field is `Λ(ξ) = Λᵣ exp(ψ̃(ξ))`. The strains (physics.md §2, paper eqs. [5]–[9]) per unit
+//! reference arc length `s` (`ds = J dξ`, `J = |X'(ξ)|`) are
+//! `Γ = exp(ψ̃)ᵀ y_s − Γ⁰`, `K = T(ψ) ψ_s − K⁰`,
+//! (`K̃ = Λᵀ Λ_s` with the material tangent operator `T` of [`crate::rotation::tangent`]),
+//! `Γ⁰`, `K⁰` being the same expressions in the reference configuration — zero strain there
+//! for a straight or a curved reference axis alike (Jelenić & Crisfield 1999, §4).
+//! For `p = 1` this is exactly the two-node element of [`super::beam`].
+//!
+//! A node may be more than π away from the reference node (a cantilever rolled into a full
+//! circle by one element puts its ends ±π from the middle): `ψᵢ` is the branch
+//! `φ̂ (|φ| + 2πk)` of the logarithm `φ` nearest to its neighbour's `ψ`, walking out from
+//! the reference node, so the interpolated field is continuous at any rotation.
+//!
+//! # Quadrature
+//! Strain energy `U = ∫ ½ (Γ·C_N Γ + K·C_M K) ds` by **reduced Gauss quadrature with `p`
+//! points**. Why: `p` points integrate degree `2p − 1` exactly, which is the degree of the
+//! strain energy of the linearised element with its derivative fields `u_s`, `θ_s`, `θ` of
+//! degree `p − 1, p − 1, p`, except the `θ × E₁` part of the shear strain, whose exact
+//! integration is what locks (Prathap & Bhashyam 1982; Reissner/Simo beams, Crisfield 1991
+//! §7.4). No spurious zero-energy mode: zero strains at `p` distinct points make the
+//! degree-`(p − 1)` polynomials `θ_s` and `u_s − θ × E₁` vanish identically, i.e. a rigid
+//! motion — so the stiffness keeps its full rank `6(p + 1) − 6`.
+//! Inertia uses `p + 1` points (exact for the consistent mass of a straight element).
+//!
+//! # Internal forces and exact tangent
+//! `U` is a sum over Gauss points of the energy density of nine local numbers
+//! `(ψ, ψ_s, y_s)` at the point, which depend linearly on the nodal `zᵢ = (yᵢ, ψᵢ)`; each
+//! `zᵢ` depends on node `i` and the reference node only. So, in exponential coordinates
+//! `Rᵢ exp(θ̃ᵢ)` of every node, `U(q) = Ũ(z(q))` and
+//! - forces `f = Zᵀ ∇Ũ` (`Z = ∂z/∂q`),
+//! - Hessian `∇²U = Zᵀ ∇²Ũ Z + Σₐ (∇Ũ)ₐ ∇²zₐ`,
+//!
+//! with the gradient of each point's energy density (9 variables) and the Jacobian `Z` in
+//! closed form ([`BeamP::density_grad`], `internal_forces`), and the second derivatives as
+//! forward-mode derivatives of those gradients by the fixed-size [`Dual`] numbers (9 directions
+//! per point, 6 per node for `ψᵢ(θᵢ, θᵣ)`; `yᵢ` is linear in the positions and its Hessian
+//! is written out): exact to round-off, at `O(n²)` per element. The iteration matrix is the derivative of the forces along `Rᵢ exp(ε eₖ)`:
+//! `∂f/∂q = ∇²U + diag(½ f̃_Θᵢ)` on the rotation blocks (the Baker–Campbell–Hausdorff term
+//! `exp(e) exp(θ) = exp(e + θ + ½ e × θ + …)`). Checked against central differences.
+//!
+//! # Inertia (paper eqs. [10]–[11])
+//! Consistent translational mass `Mᵢⱼ = ∫ ρA Nᵢ Nⱼ ds`; rotary inertia at the nodes
+//! `Jᵢ = (∫ Nᵢ ds) Λ⁰ᵢ ρ diag(I₂+I₃, I₂, I₃) Λ⁰ᵢᵀ` in the node's material frame — on GLL nodes
+//! this is the GLL quadrature of the rotary kinetic energy (spectral-element mass lumping,
+//! exact to degree `2p − 1`) — with its gyroscopic force `J Ω̇ + Ω × J Ω`, as the
+//! two-node beam. Gravity: `∫ ρA Nᵢ ds g` on node `i`.
+
+use super::beam::{Beam, BeamProperties, default_axis2, reference_triad};
+use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
+use crate::dual::{Dual, Real};
+use crate::lagrange;
+use crate::model::ElementId;
+use crate::model::arc::Arc;
+use crate::model::{ElementKind, Model};
+use crate::rotation::{self, c, skew};
+use nalgebra::{Matrix3, SMatrix, Vector3};
+use std::cell::RefCell;
+use std::f64::consts::PI;
+
+/// The largest order the element accepts (13 nodes beyond which nothing is gained in double
+/// precision for smooth fields; the spectral rules stay accurate well beyond).
+pub const MAX_ORDER: usize = 16;
+
+/// Shape functions of one quadrature point.
+#[derive(Debug, Clone)]
+struct Point {
+    /// `Nᵢ(ξ)`.
+    n: Vec<f64>,
+    /// `dNᵢ/ds = N'ᵢ(ξ)/J`.
+    ds: Vec<f64>,
+    /// Weight times Jacobian, m.
+    wj: f64,
+    /// Reference strains `Γ⁰`, `K⁰`.
+    gamma0: Vector3<f64>,
+    kappa0: Vector3<f64>,
+}
+
+/// A geometrically exact beam of order `p` with `p + 1` nodes.
+#[derive(Debug, Clone)]
+pub struct BeamP {
+    id: ElementId,
+    /// Dense node indices along the axis (first end, interior, last end).
+    nodes: Vec<usize>,
+    /// Reference node `⌊p/2⌋`.
+    refn: usize,
+    /// Reference triads at the nodes.
+    lambda0: Vec<Matrix3<f64>>,
+    props: BeamProperties,
+    /// Stiffness points (`p`, reduced Gauss).
+    stiff: Vec<Point>,
+    /// The element's midpoint `ξ = 0`, for the output of strains.
+    mid: Point,
+    /// Consistent translational mass, `n × n`, row-major, kg.
+    mass: Vec<f64>,
+    /// `∫ ρA Nᵢ ds`, kg.
+    lumped: Vec<f64>,
+    /// Rotary inertia at each node, node material frame.
+    j_node: Vec<Matrix3<f64>>,
+    length: f64,
+}
+
+/// Scratch buffers of the evaluation, one per thread (grown once: no allocation per step).
+#[derive(Default)]
+struct Scratch {
+    shift: Vec<f64>,
+    z: Vec<[f64; 6]>,
+    gz: Vec<[f64; 6]>,
+    jac: Vec<SMatrix<f64, 6, 12>>,
+    ht: Vec<SMatrix<f64, 6, 6>>,
+    hp: Vec<SMatrix<f64, 9, 6>>,
+    force: Vec<[f64; 6]>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+impl Scratch {
+    fn size(&mut self, n: usize) {
+        if self.z.len() < n {
+            self.shift.resize(n, 0.0);
+            self.z.resize(n, [0.0; 6]);
+            self.gz.resize(n, [0.0; 6]);
+            self.jac.resize(n, SMatrix::zeros());
+            self.ht.resize(n * n, SMatrix::zeros());
+            self.hp.resize(n, SMatrix::zeros());
+            self.force.resize(n, [0.0; 6]);
+        }
+    }
+}
+
+/// `zᵢ = (yᵢ, ψᵢ)` of a node against the reference node, generic in the scalar: node `i` at
+/// `x`, `R exp(θ̃) Λ⁰`, the reference node at `x_r`, `R_r exp(θ̃_r) Λ⁰_r`; `shift = 2πk`
+/// selects the branch of the logarithm.
+#[allow(clippy::too_many_arguments)]
+fn local_vars<S: Real>(
+    x: &Vector3<S>,
+    th: &Vector3<S>,
+    xr: &Vector3<S>,
+    thr: &Vector3<S>,
+    r: &Matrix3<f64>,
+    rr: &Matrix3<f64>,
+    l0: &Matrix3<f64>,
+    l0r: &Matrix3<f64>,
+    shift: f64,
+) -> [S; 6] {
+    let li = rotation::mm(&rotation::mm(&r.map(c), &rotation::exp(th)), &l0.map(c));
+    let lr = rotation::mm(&rotation::mm(&rr.map(c), &rotation::exp(thr)), &l0r.map(c));
+    let mut psi = rotation::log(&rotation::mtm(&lr, &li));
+    if shift != 0.0 {
+        let n = psi.dot(&psi).sqrt();
+        psi *= S::one() + c::<S>(shift) / n;
+    }
+    let y = rotation::mtv(&lr, &(x - xr));
+    [y.x, y.y, y.z, psi.x, psi.y, psi.z]
+}
+
+/// Strains `(Λᵀ x_s, T(ψ) ψ_s)` (before subtracting the reference) from the local numbers
+/// of a point: `ψ`, `ψ_s`, `y_s`.
+fn point_strains<S: Real>(
+    psi: &Vector3<S>,
+    dpsi: &Vector3<S>,
+    dy: &Vector3<S>,
+) -> (Vector3<S>, Vector3<S>) {
+    let e = rotation::exp(psi);
+    (
+        rotation::mtv(&e, dy),
+        rotation::mv(&rotation::tangent(psi), dpsi),
+    )
+}
+
+/// `(b, d, b′, d′)` with `b = (1 − cos φ)/φ²`, `d = (φ − sin φ)/φ³` (so that
+/// `T(ψ) = I − b ψ̃ + d ψ̃²`) and their derivatives with respect to `x = φ²`:
+/// `b′ = (φ sin φ − 2(1 − cos φ))/(2φ⁴)`, `d′ = ((1 − cos φ)φ − 3(φ − sin φ))/(2φ⁵)`;
+/// Taylor series in `x` below `x = 0.01` (four terms: truncation < 1e-12 relative).
+fn t_coefficients<S: Real>(x: S) -> (S, S, S, S) {
+    if x < c(1e-2) {
+        let b = c::<S>(0.5) - x / c(24.0) + x * x / c(720.0) - x * x * x / c(40320.0);
+        let d = c::<S>(1.0 / 6.0) - x / c(120.0) + x * x / c(5040.0) - x * x * x / c(362880.0);
+        let db = c::<S>(-1.0 / 24.0) + x / c(360.0) - x * x / c(13440.0) + x * x * x / c(907200.0);
+        let dd =
+            c::<S>(-1.0 / 120.0) + x / c(2520.0) - x * x / c(120960.0) + x * x * x / c(9979200.0);
+        (b, d, db, dd)
+    } else {
+        let f = x.sqrt();
+        let (sn, cs) = (f.sin(), f.cos());
+        let x2 = x * x;
+        (
+            (S::one() - cs) / x,
+            (f - sn) / (x * f),
+            (f * sn - (S::one() - cs) * c(2.0)) / (x2 * c(2.0)),
+            ((S::one() - cs) * f - (f - sn) * c(3.0)) / (x2 * f * c(2.0)),
+        )
+    }
+}
+
+/// The log branch shift `2πk` of `φ` nearest to `prev`.
+fn branch(phi: &Vector3<f64>, prev: &Vector3<f64>) -> f64 {
+    let n = phi.norm();
+    if n < 1e-8 {
+        return 0.0; // the branches are 2π apart: no choice near the identity
+    }
+    let mut best = (f64::INFINITY, 0.0);
+    for k in -3..=3 {
+        let s = 2.0 * PI * k as f64;
+        let d = (phi * (1.0 + s / n) - prev).norm();
+        if d < best.0 {
+            best = (d, s);
+        }
+    }
+    best.1
+}
+
+/// The solver element of a model's beam whose nodes (dense indices, along the axis) are
+/// `nodes`: the two-node [`super::beam::Beam`] for two nodes (fast path; an `ARC` beam of
+/// order 1 is a chord of its arc), a [`BeamP`] of order `nodes.len() − 1` otherwise, with
+/// the nodes at the GLL points and reference triads along the straight or curved axis:
+/// `t₁` the unit tangent (chord direction, or the arc's tangent at the node), `t₂` the
+/// `AXIS2` direction made normal to `t₁` (default: [`super::beam::default_axis2`] of the
+/// chord, or the normal of the arc's plane), `t₃ = t₁ × t₂`.
+pub fn from_model(
+    model: &Model,
+    el: &crate::model::Element,
+    nodes: Vec<usize>,
+) -> Box<dyn Element> {
+    let ElementKind::Beam {
+        material,
+        section,
+        axis2,
+        arc,
+        ..
+    } = &el.kind
+    else {
+        unreachable!("from_model is called on beams only")
+    };
+    let (mat, sec) = (&model.materials[material], &model.sections[section]);
+    let props = BeamProperties {
+        cn: Vector3::new(
+            mat.young * sec.area,
+            sec.shear_factor * mat.shear * sec.area,
+            sec.shear_factor * mat.shear * sec.area,
+        ),
+        cm: Vector3::new(
+            mat.shear * sec.torsion,
+            mat.young * sec.i2,
+            mat.young * sec.i3,
+        ),
+        mass: mat.density * sec.area,
+        inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
+    };
+    let x0: Vec<Vector3<f64>> = nodes.iter().map(|&i| model.nodes[i].position).collect();
+    let (xa, xb) = (x0[0], x0[x0.len() - 1]);
+    if nodes.len() == 2 {
+        return Box::new(Beam::new(
+            el.id,
+            [nodes[0], nodes[1]],
+            &xa,
+            &xb,
+            *axis2,
+            props,
+        ));
+    }
+    let curved = arc.and_then(|c| Arc::new(&xa, &xb, &c).ok());
+    let triads: Vec<Matrix3<f64>> = x0
+        .iter()
+        .map(|x| match &curved {
+            Some(a) => {
+                let t1 = a.tangent_at(x);
+                let ax = axis2.unwrap_or_else(|| a.normal());
+                let t2 = (ax - t1 * t1.dot(&ax)).normalize();
+                Matrix3::from_columns(&[t1, t2, t1.cross(&t2)])
+            }
+            None => reference_triad(
+                &xa,
+                &xb,
+                &axis2.unwrap_or_else(|| default_axis2(&(xb - xa))),
+            ),
+        })
+        .collect();
+    let (xi, _) = lagrange::gll(nodes.len() - 1);
+    Box::new(BeamP::new(el.id, nodes, &xi, &x0, &triads, props))
+}
+
+impl BeamP {
+    /// A beam through the nodes `nodes` (dense indices, along the axis) at parametric
+    /// positions `xi` (increasing from −1 to 1), reference positions `x0` and reference triads
+    /// `triads` (axis 1 along the reference axis).
+    pub fn new(
+        id: ElementId,
+        nodes: Vec<usize>,
+        xi: &[f64],
+        x0: &[Vector3<f64>],
+        triads: &[Matrix3<f64>],
+        props: BeamProperties,
+    ) -> Self {
+        let n = nodes.len();
+        assert!((2..=MAX_ORDER + 1).contains(&n) && xi.len() == n && x0.len() == n);
+        let p = n - 1;
+        let point = |x: f64, w: f64| {
+            let (nv, dv) = lagrange::lagrange(xi, x);
+            let dx: Vector3<f64> = dv.iter().zip(x0).map(|(d, x)| x * *d).sum();
+            let jac = dx.norm();
+            Point {
+                n: nv,
+                ds: dv.iter().map(|d| d / jac).collect(),
+                wj: w * jac,
+                gamma0: Vector3::zeros(),
+                kappa0: Vector3::zeros(),
+            }
+        };
+        let (gs, gw) = lagrange::gauss(p);
+        let stiff: Vec<Point> = gs.iter().zip(&gw).map(|(x, w)| point(*x, *w)).collect();
+        let (ms, mw) = lagrange::gauss(p + 1);
+        let mpts: Vec<Point> = ms.iter().zip(&mw).map(|(x, w)| point(*x, *w)).collect();
+        let mut mass = vec![0.0; n * n];
+        let mut lumped = vec![0.0; n];
+        let mut length = 0.0;
+        for q in &mpts {
+            length += q.wj;
+            for i in 0..n {
+                lumped[i] += q.wj * props.mass * q.n[i];
+                for j in 0..n {
+                    mass[i * n + j] += q.wj * props.mass * q.n[i] * q.n[j];
+                }
+            }
+        }
+        // ∫ Nᵢ ds by the mass rule (exact for a straight element: degree p).
+        let j_node = (0..n)
+            .map(|i| {
+                let w = lumped[i] / props.mass.max(f64::MIN_POSITIVE);
+                triads[i] * Matrix3::from_diagonal(&(props.inertia * w)) * triads[i].transpose()
+            })
+            .collect();
+        let mut beam = BeamP {
+            id,
+            nodes,
+            refn: p / 2,
+            lambda0: triads.to_vec(),
+            props,
+            stiff,
+            mid: point(0.0, 0.0),
+            mass,
+            lumped,
+            j_node,
+            length,
+        };
+        // Reference strains: the same expressions at the reference state.
+        let rest: Vec<NodeState> = x0.iter().map(|x| NodeState::at_rest(*x)).collect();
+        let mut z = vec![[0.0; 6]; n];
+        let mut shift = vec![0.0; n];
+        let idx: Vec<usize> = (0..n).collect();
+        beam.locals(&rest, &idx, &mut z, &mut shift);
+        let mut pts = std::mem::take(&mut beam.stiff);
+        pts.push(beam.mid.clone());
+        for q in &mut pts {
+            let (g, k) = Self::strains_at(q, &z);
+            q.gamma0 = g;
+            q.kappa0 = k;
+        }
+        beam.mid = pts.pop().expect("mid point");
+        beam.stiff = pts;
+        beam
+    }
+
+    /// The order `p`.
+    pub fn order(&self) -> usize {
+        self.nodes.len() - 1
+    }
+
+    /// Reference length (arc length of the reference axis), m.
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// Local numbers `zᵢ` and branch shifts of every node (f64); `idx[k]` is node `k`'s index
+    /// into `nodes`.
+    fn locals(&self, nodes: &[NodeState], idx: &[usize], z: &mut [[f64; 6]], shift: &mut [f64]) {
+        let n = idx.len();
+        let m = self.refn;
+        let sr = &nodes[idx[m]];
+        let lr = sr.r * self.lambda0[m];
+        let phi = |k: usize| rotation::log(&(lr.transpose() * nodes[idx[k]].r * self.lambda0[k]));
+        z[m] = [0.0; 6];
+        shift[m] = 0.0;
+        let mut set = |k: usize, prev: Vector3<f64>| {
+            let f = phi(k);
+            let s = branch(&f, &prev);
+            shift[k] = s;
+            let psi = if s != 0.0 {
+                f * (1.0 + s / f.norm())
+            } else {
+                f
+            };
+            let y = lr.transpose() * (nodes[idx[k]].x - sr.x);
+            z[k] = [y.x, y.y, y.z, psi.x, psi.y, psi.z];
+            psi
+        };
+        let mut prev = Vector3::zeros();
+        for k in m + 1..n {
+            prev = set(k, prev);
+        }
+        prev = Vector3::zeros();
+        for k in (0..m).rev() {
+            prev = set(k, prev);
+        }
+    }
+
+    /// The nine local numbers `(ψ, ψ_s, y_s)` of a point.
+    fn point_vars(q: &Point, z: &[[f64; 6]]) -> [f64; 9] {
+        let mut v = [0.0; 9];
+        for (i, zi) in z.iter().enumerate() {
+            for a in 0..3 {
+                v[a] += q.n[i] * zi[3 + a];
+                v[3 + a] += q.ds[i] * zi[3 + a];
+                v[6 + a] += q.ds[i] * zi[a];
+            }
+        }
+        v
+    }
+
+    /// Total strains `(Λᵀx_s, K)` at a point (reference not subtracted).
+    fn strains_at(q: &Point, z: &[[f64; 6]]) -> (Vector3<f64>, Vector3<f64>) {
+        let v = Self::point_vars(q, z);
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        point_strains(&at(0), &at(3), &at(6))
+    }
+
+    /// Energy density `½ Γ·C_N Γ + ½ K·C_M K` at a point from its nine local numbers.
+    fn density<S: Real>(&self, q: &Point, v: &[S; 9]) -> S {
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        let (g, k) = point_strains(&at(0), &at(3), &at(6));
+        let g = g - q.gamma0.map(c::<S>);
+        let k = k - q.kappa0.map(c::<S>);
+        let cn: Vector3<S> = self.props.cn.map(c);
+        let cm: Vector3<S> = self.props.cm.map(c);
+        (g.component_mul(&cn).dot(&g) + k.component_mul(&cm).dot(&k)) * c::<S>(0.5)
+    }
+
+    /// Gradient of the energy density in its nine local numbers `(ψ, ψ_s, y_s)`, in closed
+    /// form (generic: differentiated once more by dual numbers for the tangent). With
+    /// `a = exp(ψ̃)ᵀ y_s`, `v = ψ_s`, `N = C_N(a − Γ⁰)`, `M = C_M(T(ψ) v − K⁰)`:
+    /// `∂e/∂y_s = exp(ψ̃) N`, `∂e/∂ψ_s = T(ψ)ᵀ M`,
+    /// `∂e/∂ψ = T(ψ)ᵀ (N × a) + (∂(T(ψ)v)/∂ψ)ᵀ M` (`δ exp(ψ̃)ᵀ = −(T δψ)~ exp(ψ̃)ᵀ`), and with
+    /// `T v = v − b ψ × v + d ψ × (ψ × v)` ([`t_coefficients`]):
+    /// `(∂(T v)/∂ψ)ᵀ M = −2b′ ((ψ×v)·M) ψ + b M × v + 2d′ ((ψ×(ψ×v))·M) ψ
+    ///  − d (M × (ψ × v) + (M × ψ) × v)`.
+    fn density_grad<S: Real>(&self, q: &Point, v: &[S; 9]) -> [S; 9] {
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        let (psi, dpsi, dy) = (at(0), at(3), at(6));
+        let e = rotation::exp(&psi);
+        let t = rotation::tangent(&psi);
+        let a = rotation::mtv(&e, &dy);
+        let cn: Vector3<S> = self.props.cn.map(c);
+        let cm: Vector3<S> = self.props.cm.map(c);
+        let nn = (a - q.gamma0.map(c::<S>)).component_mul(&cn);
+        let mm = (rotation::mv(&t, &dpsi) - q.kappa0.map(c::<S>)).component_mul(&cm);
+        let g_dy = rotation::mv(&e, &nn);
+        let g_dpsi = rotation::mtv(&t, &mm);
+        let (b, d, db, dd) = t_coefficients(psi.dot(&psi));
+        let pv = psi.cross(&dpsi);
+        let ppv = psi.cross(&pv);
+        let two = c::<S>(2.0);
+        let g_psi = rotation::mtv(&t, &nn.cross(&a)) - psi * (db * two * pv.dot(&mm))
+            + mm.cross(&dpsi) * b
+            + psi * (dd * two * ppv.dot(&mm))
+            - (mm.cross(&pv) + mm.cross(&psi).cross(&dpsi)) * d;
+        [
+            g_psi.x, g_psi.y, g_psi.z, g_dpsi.x, g_dpsi.y, g_dpsi.z, g_dy.x, g_dy.y, g_dy.z,
+        ]
+    }
+
+    /// Strains `Γ`, `K` at the element's midpoint `ξ = 0`.
+    pub fn strains(&self, nodes: &[NodeState]) -> (Vector3<f64>, Vector3<f64>) {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let Scratch { z, shift, .. } = &mut *s;
+            self.locals(nodes, &self.nodes, &mut z[..n], &mut shift[..n]);
+            let (g, k) = Self::strains_at(&self.mid, &z[..n]);
+            (g - self.mid.gamma0, k - self.mid.kappa0)
+        })
+    }
+
+    /// Internal forces only (the residual path, evaluated at every Newton iteration): the
+    /// chain rule of the module doc with the Jacobian of the local numbers in closed form,
+    /// `∂yᵢ/∂xᵢ = Λᵣᵀ = −∂yᵢ/∂xᵣ`, `∂yᵢ/∂θᵣ = ỹᵢ Λ⁰ᵣᵀ`,
+    /// `∂ψᵢ/∂θᵢ = T⁻¹(ψᵢ) Λ⁰ᵢᵀ`, `∂ψᵢ/∂θᵣ = −T⁻¹(ψᵢ) exp(ψ̃ᵢ)ᵀ Λ⁰ᵣᵀ`
+    /// (from `exp(ψ̃ᵢ) = Λᵣᵀ Λᵢ`, `δ exp(ψ̃) = exp(ψ̃)(T(ψ) δψ)~`), and the gradient of each
+    /// point's energy density `∂e/∂y_s = exp(ψ̃) N`, `∂e/∂ψ_s = T(ψ)ᵀ M`, `∂e/∂ψ` by a
+    /// 3-direction dual number. Same numbers as the tangent path to round-off (tested).
+    fn internal_forces(&self, nodes: &[NodeState], out: &mut Local) {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let sc = &mut *s;
+            let m = self.refn;
+            self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
+            for g in sc.gz[..n].iter_mut() {
+                *g = [0.0; 6];
+            }
+            for q in &self.stiff {
+                let v = Self::point_vars(q, &sc.z[..n]);
+                let at = |k: usize, v: &[f64; 9]| Vector3::new(v[k], v[k + 1], v[k + 2]);
+                let g = self.density_grad(q, &v);
+                let (g_psi, g_dpsi, g_dy) = (at(0, &g), at(3, &g), at(6, &g));
+                for i in (0..n).filter(|&i| i != m) {
+                    for k in 0..3 {
+                        sc.gz[i][k] += q.wj * q.ds[i] * g_dy[k];
+                        sc.gz[i][3 + k] += q.wj * (q.n[i] * g_psi[k] + q.ds[i] * g_dpsi[k]);
+                    }
+                }
+            }
+            let sr = &nodes[self.nodes[m]];
+            let lr = sr.r * self.lambda0[m];
+            let l0r = &self.lambda0[m];
+            let (mut fxr, mut fthr) = (Vector3::zeros(), Vector3::zeros());
+            for i in (0..n).filter(|&i| i != m) {
+                let z = &sc.z[i];
+                let (y, psi) = (
+                    Vector3::new(z[0], z[1], z[2]),
+                    Vector3::new(z[3], z[4], z[5]),
+                );
+                let gy = Vector3::new(sc.gz[i][0], sc.gz[i][1], sc.gz[i][2]);
+                let gp = Vector3::new(sc.gz[i][3], sc.gz[i][4], sc.gz[i][5]);
+                let fx = lr * gy;
+                let tig = rotation::tangent_inv(&psi).transpose() * gp;
+                let fth = self.lambda0[i] * tig;
+                fxr -= fx;
+                fthr += l0r * (gy.cross(&y) - rotation::exp(&psi) * tig);
+                out.add_res(tx(i), &fx);
+                out.add_res(rx(i), &fth);
+            }
+            out.add_res(tx(m), &fxr);
+            out.add_res(rx(m), &fthr);
+        })
+    }
+
+    /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
+    /// `tangent` their exact derivative into `out.tan` (module doc).
+    fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
+        if !tangent {
+            return self.internal_forces(nodes, out);
+        }
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let sc = &mut *s;
+            let m = self.refn;
+            self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
+            // Jacobians of the local numbers of every node but the reference, columns
+            // (xᵢ, θᵢ, xᵣ, θᵣ), in closed form (see `internal_forces`; ψ does not depend on positions).
+            let sr = &nodes[self.nodes[m]];
+            let lr = sr.r * self.lambda0[m];
+            let l0r = &self.lambda0[m];
+            for k in (0..n).filter(|&k| k != m) {
+                let l0 = &self.lambda0[k];
+                let z = &sc.z[k];
+                let (y, psi) = (
+                    Vector3::new(z[0], z[1], z[2]),
+                    Vector3::new(z[3], z[4], z[5]),
+                );
+                let ti = rotation::tangent_inv(&psi);
+                let dk = ti * l0.transpose();
+                let dr = -(ti * rotation::exp(&psi).transpose() * l0r.transpose());
+                let jac = &mut sc.jac[k];
+                *jac = SMatrix::zeros();
+                let yr = skew(&y) * l0r.transpose();
+                for r in 0..3 {
+                    for c in 0..3 {
+                        jac[(r, c)] = lr[(c, r)];
+                        jac[(r, 6 + c)] = -lr[(c, r)];
+                        jac[(r, 9 + c)] = yr[(r, c)];
+                        jac[(3 + r, 3 + c)] = dk[(r, c)];
+                        jac[(3 + r, 9 + c)] = dr[(r, c)];
+                    }
+                }
+            }
+            // Gradient (and Hessian) of Ũ in the local numbers.
+            for g in sc.gz[..n].iter_mut() {
+                *g = [0.0; 6];
+            }
+            for h in sc.ht[..n * n].iter_mut() {
+                *h = SMatrix::zeros();
+            }
+            for q in &self.stiff {
+                let v = Self::point_vars(q, &sc.z[..n]);
+                let vars: [Dual<9>; 9] = std::array::from_fn(|k| Dual::var(v[k], k));
+                let gd = self.density_grad(q, &vars);
+                let grad: [f64; 9] = std::array::from_fn(|k| gd[k].re);
+                let h = SMatrix::<f64, 9, 9>::from_fn(|r, c| gd[r].eps[c]);
+                for i in (0..n).filter(|&i| i != m) {
+                    for a in 0..3 {
+                        sc.gz[i][a] += q.wj * q.ds[i] * grad[6 + a];
+                        sc.gz[i][3 + a] += q.wj * (q.n[i] * grad[a] + q.ds[i] * grad[3 + a]);
+                    }
+                }
+                {
+                    // hp_j = h P_j (9×6), then H̃_ij += wJ P_iᵀ hp_j.
+                    for j in (0..n).filter(|&j| j != m) {
+                        let hp = &mut sc.hp[j];
+                        for r in 0..9 {
+                            for a in 0..3 {
+                                hp[(r, a)] = q.ds[j] * h[(r, 6 + a)];
+                                hp[(r, 3 + a)] = q.n[j] * h[(r, a)] + q.ds[j] * h[(r, 3 + a)];
+                            }
+                        }
+                    }
+                    for i in (0..n).filter(|&i| i != m) {
+                        for j in (0..n).filter(|&j| j != m) {
+                            let hp = &sc.hp[j];
+                            let ht = &mut sc.ht[i * n + j];
+                            for col in 0..6 {
+                                for a in 0..3 {
+                                    ht[(a, col)] += q.wj * q.ds[i] * hp[(6 + a, col)];
+                                    ht[(3 + a, col)] +=
+                                        q.wj * (q.n[i] * hp[(a, col)] + q.ds[i] * hp[(3 + a, col)]);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            // Forces f = Zᵀ ∇Ũ: node k's columns 0..6 of its Jacobian, the reference node's 6..12.
+            for f in sc.force[..n].iter_mut() {
+                *f = [0.0; 6];
+            }
+            for k in (0..n).filter(|&k| k != m) {
+                for col in 0..12 {
+                    let v: f64 = (0..6).map(|a| sc.jac[k][(a, col)] * sc.gz[k][a]).sum();
+                    let node = if col < 6 { k } else { m };
+                    sc.force[node][col % 6] += v;
+                }
+            }
+            for (k, f) in sc.force[..n].iter().enumerate() {
+                for a in 0..6 {
+                    out.res[6 * k + a] += f[a];
+                }
+            }
+            let nl = out.n;
+            let loc = |k: usize, col: usize| {
+                if col < 6 {
+                    6 * k + col
+                } else {
+                    6 * m + col - 6
+                }
+            };
+            // Zᵀ H̃ Z.
+            for i in (0..n).filter(|&i| i != m) {
+                for j in (0..n).filter(|&j| j != m) {
+                    let b = sc.jac[i].transpose() * sc.ht[i * n + j] * sc.jac[j];
+                    for col in 0..12 {
+                        let cc = loc(j, col);
+                        for row in 0..12 {
+                            out.tan[cc * nl + loc(i, row)] += b[(row, col)];
+                        }
+                    }
+                }
+            }
+            // Σₐ (∇Ũ)ₐ ∇²zₐ. ψ: the dual Hessians in (θᵢ, θᵣ). y = Λ⁰ᵣᵀ exp(−θ̃ᵣ) Rᵣᵀ (xᵢ − xᵣ):
+            // with u = Λ⁰ᵣ g_y, w = Rᵣᵀ(xᵢ − xᵣ), g_y·y = u·exp(−θ̃ᵣ) w has the Hessian
+            // ½(u wᵀ + w uᵀ) − (u·w) I in θᵣ and ũ Rᵣᵀ in (θᵣ, xᵢ) (−ũ Rᵣᵀ in (θᵣ, xᵣ)).
+            for k in (0..n).filter(|&k| k != m) {
+                let gz = &sc.gz[k];
+                let mut sec = SMatrix::<f64, 12, 12>::zeros();
+                // Σₐ g_ψₐ ∇²ψₐ in (θᵢ, θᵣ): the derivative at θ = 0 of the gradient of g_ψ·ψ in
+                // the additive chart, G(θ) = [T(θᵢ)ᵀ Λ⁰ᵢ T⁻ᵀ(ψ) g_ψ; −T(θᵣ)ᵀ Λ⁰ᵣ exp(ψ̃) T⁻ᵀ(ψ) g_ψ]
+                // (`R exp(θ̃ + δ̃) = R exp(θ̃) exp((T(θ)δ)~)`), by 6-direction dual numbers.
+                {
+                    type D = Dual<6>;
+                    let st = &nodes[self.nodes[k]];
+                    let (l0, sh) = (&self.lambda0[k], sc.shift[k]);
+                    let th = Vector3::from_fn(|a, _| D::var(0.0, a));
+                    let thr = Vector3::from_fn(|a, _| D::var(0.0, 3 + a));
+                    let zero = Vector3::from_element(D::constant(0.0));
+                    let lv = local_vars(&zero, &th, &zero, &thr, &st.r, &sr.r, l0, l0r, sh);
+                    let psi = Vector3::new(lv[3], lv[4], lv[5]);
+                    let gpsi: Vector3<D> = Vector3::new(gz[3], gz[4], gz[5]).map(D::constant);
+                    let w = rotation::mtv(&rotation::tangent_inv(&psi), &gpsi);
+                    let gk = rotation::mtv(&rotation::tangent(&th), &rotation::mv(&l0.map(c), &w));
+                    let gr = -rotation::mtv(
+                        &rotation::tangent(&thr),
+                        &rotation::mv(&l0r.map(c), &rotation::mv(&rotation::exp(&psi), &w)),
+                    );
+                    for r in 0..3 {
+                        for col in 0..6 {
+                            let cc = col + 3 + 3 * (col / 3);
+                            sec[(3 + r, cc)] += gk[r].eps[col];
+                            sec[(9 + r, cc)] += gr[r].eps[col];
+                        }
+                    }
+                }
+                let gy = Vector3::new(gz[0], gz[1], gz[2]);
+                let u = l0r * gy;
+                let w = sr.r.transpose() * (nodes[self.nodes[k]].x - sr.x);
+                let hrr =
+                    (u * w.transpose() + w * u.transpose()) * 0.5 - Matrix3::identity() * u.dot(&w);
+                let mix = skew(&u) * sr.r.transpose();
+                for r in 0..3 {
+                    for c in 0..3 {
+                        sec[(9 + r, 9 + c)] += hrr[(r, c)];
+                        sec[(9 + r, c)] += mix[(r, c)];
+                        sec[(9 + r, 6 + c)] -= mix[(r, c)];
+                        sec[(c, 9 + r)] += mix[(r, c)];
+                        sec[(6 + c, 9 + r)] -= mix[(r, c)];
+                    }
+                }
+                for col in 0..12 {
+                    let cc = loc(k, col);
+                    for row in 0..12 {
+                        out.tan[cc * nl + loc(k, row)] += sec[(row, col)];
+                    }
+                }
+            }
+            // ½ f̃_Θ on the rotation diagonal blocks.
+            for (k, f) in sc.force[..n].iter().enumerate() {
+                let half = skew(&Vector3::new(f[3], f[4], f[5])) * 0.5;
+                out.add_block(rx(k), rx(k), &half);
+            }
+        })
+    }
+}
+
+impl Element for BeamP {
+    fn id(&self) -> ElementId {
+        self.id
+    }
+
+    fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+
+    fn evaluate(
+        &self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        tangent: bool,
+        out: &mut Local,
+    ) {
+        self.internal(nodes, tangent, out);
+        let n = self.nodes.len();
+        for k in 0..n {
+            out.add_res(tx(k), &(-ctx.gravity * self.lumped[k]));
+        }
+        if !ctx.dynamic {
+            return;
+        }
+        for i in 0..n {
+            let mut f = Vector3::zeros();
+            for j in 0..n {
+                f += nodes[self.nodes[j]].a * self.mass[i * n + j];
+            }
+            out.add_res(tx(i), &f);
+            let s = &nodes[self.nodes[i]];
+            let jw = self.j_node[i] * s.w;
+            out.add_res(rx(i), &(self.j_node[i] * s.wd + s.w.cross(&jw)));
+        }
+        if tangent {
+            for i in 0..n {
+                for j in 0..n {
+                    let mij = Matrix3::identity() * (ctx.c_a * self.mass[i * n + j]);
+                    out.add_rate_block(tx(i), tx(j), &mij);
+                }
+                let (s, jn) = (&nodes[self.nodes[i]], &self.j_node[i]);
+                let gyro = skew(&s.w) * jn - skew(&(jn * s.w));
+                out.add_rate_block(rx(i), rx(i), &(jn * ctx.c_a + gyro * ctx.c_v));
+            }
+        }
+    }
+
+    fn force_scale(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> f64 {
+        let mut f2: f64 = 0.0;
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let (s, m, j) = (&nodes[i], self.lumped[k], &self.j_node[k]);
+            f2 = f2
+                .max(m * m * gravity.norm_squared())
+                .max(m * m * s.a.norm_squared())
+                .max((j * s.wd).norm_squared())
+                .max(s.w.cross(&(j * s.w)).norm_squared());
+        }
+        f2.sqrt()
+    }
+
+    fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {
+        let n = self.nodes.len();
+        let strain = SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            s.size(n);
+            let Scratch { z, shift, .. } = &mut *s;
+            self.locals(nodes, &self.nodes, &mut z[..n], &mut shift[..n]);
+            self.stiff
+                .iter()
+                .map(|q| q.wj * self.density(q, &Self::point_vars(q, &z[..n])))
+                .sum::<f64>()
+        });
+        let mut kinetic = 0.0;
+        let mut grav = 0.0;
+        for i in 0..n {
+            let s = &nodes[self.nodes[i]];
+            for j in 0..n {
+                kinetic += 0.5 * self.mass[i * n + j] * s.v.dot(&nodes[self.nodes[j]].v);
+            }
+            kinetic += 0.5 * s.w.dot(&(self.j_node[i] * s.w));
+            grav -= self.lumped[i] * gravity.dot(&s.x);
+        }
+        Energies {
+            kinetic,
+            strain,
+            gravity: grav,
+        }
+    }
+
+    fn output_header(&self) -> Vec<String> {
+        [
+            "n1", "n2", "n3", "m1", "m2", "m3", "gamma1", "gamma2", "gamma3", "k1", "k2", "k3",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+
+    fn write_output_row(
+        &self,
+        _ctx: &EvalContext,
+        nodes: &[NodeState],
+        _lambda: &[f64],
+        row: &mut Vec<f64>,
+    ) {
+        let (g, k) = self.strains(nodes);
+        let nn = g.component_mul(&self.props.cn);
+        let mm = k.component_mul(&self.props.cm);
+        for v in [nn, mm, g, k] {
+            row.extend_from_slice(v.as_slice());
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "beam_p_tests.rs"]
+mod tests;
+
+#[cfg(test)]
+#[path = "beam_p_cases.rs"]
+mod cases;
