@@ -6,8 +6,8 @@
 
 pub mod integrator;
 pub mod linear;
-pub mod state;
 pub mod redundancy;
+pub mod state;
 pub mod system;
 
 pub use integrator::{HhtParams, Integrator, StepInfo};
