@@ -187,10 +187,10 @@ fn space_time_study_separates_second_order_errors_in_space_and_time() {
     assert_eq!(runs.len(), 12);
     // Every run but the reference is scored, and the coarsest mesh's error is its space
     // error (the time error is 100 times smaller here).
-    let errs: Vec<f64> = runs.iter().map(|r| r[8].parse().unwrap()).collect();
+    let errs: Vec<f64> = runs.iter().map(|r| r[9].parse().unwrap()).collect();
     assert_eq!(errs[11], 0.0);
     assert!(errs[..11].iter().all(|e| *e > 0.0));
-    assert!(runs.iter().any(|r| &r[9] == "true"), "a frontier");
+    assert!(runs.iter().any(|r| &r[10] == "true"), "a frontier");
     // Two meshes cannot judge convergence in space: bad input, exit code 2.
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
         .arg("study")
@@ -209,5 +209,77 @@ fn space_time_study_separates_second_order_errors_in_space_and_time() {
         .expect("binary runs");
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("at least three meshes"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The study over beam orders (`--order 1,2,4,8`, issue 18) on the same cantilever (4 beam
+/// elements, each set to order p). The claim of elements of order p is that raising the
+/// order beats dividing the elements at equal nodes: a two-node mesh with twice the nodes
+/// cuts its error by 2² (order 2 in the element length, test above), so each doubling of p
+/// (twice the nodes per element) must cut the space error by more than 4 — for a smooth
+/// field it falls exponentially in p. The ladder's space and time checks stay those of the
+/// refinement study: the reference (order 8) is converged in both and every window scored.
+/// `--order 0` and two levels with the same number of nodes are bad input (exit 2).
+#[test]
+fn order_study_shows_errors_falling_faster_than_mesh_refinement() {
+    let dir = std::env::temp_dir().join(format!("mecano_orderstudy_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/cantilever_smooth_load.dat");
+    let study = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+            .arg("study")
+            .arg(&deck)
+            .args(args)
+            .args([
+                "--steps",
+                "4e-4,2e-4,1e-4",
+                "--nodes",
+                "5",
+                "--window",
+                "0.05",
+            ])
+            .arg("-o")
+            .arg(&dir)
+            .output()
+            .expect("binary runs")
+    };
+    let out = study(&["--order", "1,2,4,8"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0));
+    assert!(stdout.contains("space-time reference: refine 1 order 8"));
+    let mut rd = csv::Reader::from_path(dir.join("spacetime_ladders.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    assert!(rows.iter().all(|r| &r[5] == "true"), "converged: {rows:?}");
+    // Space errors per level (k·p = 1, 2, 4) and window, against order 8.
+    let space: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| &r[0] == "space")
+        .map(|r| (r[1].parse().unwrap(), r[3].parse().unwrap()))
+        .collect();
+    for w in 0..2 {
+        let e: Vec<f64> = space.iter().skip(w).step_by(2).map(|x| x.1).collect();
+        assert!(e[0] > 0.0, "order 1 has a space error: {e:?}");
+        assert!(e[1] < e[0] / 4.0 && e[2] < e[1] / 4.0, "window {w}: {e:?}");
+    }
+    let mut rd = csv::Reader::from_path(dir.join("spacetime.csv")).unwrap();
+    let runs: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    assert_eq!(runs.len(), 12);
+    assert_eq!(
+        runs.iter().map(|r| r[1].to_string()).collect::<Vec<_>>()[..],
+        ["1", "1", "1", "2", "2", "2", "4", "4", "4", "8", "8", "8"]
+    );
+    for bad in [
+        &["--order", "0,2,4"][..],
+        &["--refine", "1,2", "--order", "2,4"],
+    ] {
+        let out = study(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--order 0") || err.contains("same number of nodes"),
+            "{err}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

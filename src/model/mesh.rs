@@ -66,6 +66,12 @@ pub enum MeshError {
     /// A division factor of zero.
     #[error("a beam must be divided into at least one element")]
     ZeroCount,
+    /// A beam order outside 1..=16.
+    #[error("order {order} is not in 1..={max}", max = super::order::MAX_ORDER)]
+    Order {
+        /// The order asked for.
+        order: u32,
+    },
     /// A node that is not in the model.
     #[error("{0} is not a node of the model")]
     UnknownNode(NodeId),

@@ -89,6 +89,22 @@ impl Model {
         Ok(())
     }
 
+    /// Sets every beam, divided or not, to order `p` (`mecano-rs study --order`): the interior
+    /// nodes of the old orders are removed and those of order `p` generated at its GLL points
+    /// (numbered past every existing number; arcs are kept).
+    pub fn set_beam_order(&mut self, p: u32) -> Result<(), MeshError> {
+        if p == 0 || p > MAX_ORDER {
+            return Err(MeshError::Order { order: p });
+        }
+        self.lower_orders();
+        for el in self.elements.values_mut() {
+            if let ElementKind::Beam { order, .. } = &mut el.kind {
+                *order = p;
+            }
+        }
+        self.raise_orders(&mut Numbering::after(self))
+    }
+
     /// Removes the interior nodes of beams of order > 1 (each beam keeps its end nodes).
     pub fn lower_orders(&mut self) {
         let order_nodes = std::mem::take(&mut self.order_nodes);

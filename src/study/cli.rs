@@ -41,6 +41,11 @@ pub struct StudyArgs {
     /// space–time study, every (mesh, step) pair run, the finest of both the reference.
     #[arg(long, value_delimiter = ',')]
     pub refine: Vec<u32>,
+    /// Beam orders, comma-separated (e.g. 1,2,4,8): the space–time study with every beam of
+    /// the deck set to each order p (p + 1 nodes, `ORDER p` in grammar.md), at each
+    /// `--refine` factor; the mesh levels are ordered by k·p.
+    #[arg(long, value_delimiter = ',')]
+    pub order: Vec<u32>,
 }
 
 /// Runs `mecano-rs study` and returns the exit code (0, or 2 for bad input).
@@ -76,7 +81,7 @@ pub fn run(args: &StudyArgs) -> u8 {
         .out
         .clone()
         .unwrap_or_else(|| crate::app::default_out_dir(&args.deck, &model).join("study"));
-    if args.refine.len() > 1 {
+    if args.refine.len() > 1 || !args.order.is_empty() {
         return run_space(args, steps, nodes, out_dir);
     }
     let opts = StudyOptions {
@@ -112,17 +117,18 @@ pub fn run(args: &StudyArgs) -> u8 {
     crate::app::EXIT_OK
 }
 
-/// The space–time study (`--refine` with several factors).
+/// The space–time study (`--refine` with several factors, or `--order`).
 fn run_space(args: &StudyArgs, steps: Vec<f64>, nodes: Vec<u32>, out_dir: PathBuf) -> u8 {
     if !args.adaptive.is_empty() || args.alpha.len() > 1 {
         eprintln!(
-            "error: {}: a space-time study (several --refine factors) runs fixed steps at the deck's alpha: drop --adaptive and --alpha",
+            "error: {}: a space-time study (several --refine factors, or --order) runs fixed steps at the deck's alpha: drop --adaptive and --alpha",
             args.deck.display()
         );
         return crate::app::EXIT_BAD_INPUT;
     }
     let opts = space::SpaceTimeOptions {
         refine: args.refine.clone(),
+        orders: args.order.clone(),
         steps,
         nodes,
         window: args.window,

@@ -2,7 +2,12 @@
 //! meshes as well as of time steps.
 //!
 //! Every (mesh, step) pair of the two ladders is run (mesh `k`: every beam of the deck divided
-//! into `k` times its elements, [`crate::model::Model::refine`]). The finest mesh at the finest
+//! into `k` times its elements, [`crate::model::Model::refine`]; with `--order p1,p2,…` each
+//! refinement also at every order `p`, [`crate::model::Model::set_beam_order`], the levels
+//! ordered by `k·p`, the number of nodes per beam card less one, which is also the measure of
+//! the ratio `r` below: for p-refinement the observed algebraic order is only indicative, the
+//! convergence of smooth fields being exponential in `p`, while the convergence check stays
+//! valid). The finest mesh at the finest
 //! step is the **space–time reference**. The two errors are separated, each against a
 //! reference converged in its own variable:
 //! - **in space**, at the finest step: mesh `k`'s error is its distance to the finest mesh;
@@ -39,8 +44,12 @@ use std::path::{Path, PathBuf};
 /// What a space–time study runs.
 #[derive(Debug, Clone)]
 pub struct SpaceTimeOptions {
-    /// Refinement factors of the mesh (at least 3; the largest is the reference mesh).
+    /// Refinement factors of the mesh (the largest is the reference mesh).
     pub refine: Vec<u32>,
+    /// Beam orders (`--order`): every beam set to order p at each refinement; empty: the
+    /// deck's orders. The mesh levels are the (refine k, order p) pairs, ordered by `k·p`
+    /// (nodes per beam card, less one), at least 3 of them.
+    pub orders: Vec<u32>,
     /// Fixed time steps, s (at least 3; the smallest is the reference step).
     pub steps: Vec<f64>,
     /// User node numbers whose positions are compared.
@@ -60,6 +69,8 @@ pub struct SpaceTimeOptions {
 pub struct GridRun {
     /// Refinement factor of the mesh.
     pub refine: u32,
+    /// Order every beam was set to (`--order`); 0: the deck's orders.
+    pub order: u32,
     /// Beam elements of the refined model.
     pub beams: usize,
     /// Time step, s.
@@ -175,6 +186,48 @@ fn order(d0: f64, d1: f64, r: f64) -> f64 {
     }
 }
 
+/// The name of a mesh level: `refine k`, and `order p` when the study set the orders.
+pub fn mesh_name(k: u32, p: u32) -> String {
+    if p > 0 {
+        format!("refine {k} order {p}")
+    } else {
+        format!("refine {k}")
+    }
+}
+
+/// The mesh levels (refine k, order p; p = 0: the deck's orders) of `--refine` × `--order`,
+/// coarsest first by `k·p`. Two levels of the same `k·p` (e.g. refine 2 order 4 and refine
+/// 1 order 8) have no ratio between them and are refused.
+fn mesh_levels(refine: &[u32], orders: &[u32]) -> Result<Vec<(u32, u32)>, StudyError> {
+    let ks: Vec<u32> = if refine.is_empty() {
+        vec![1]
+    } else {
+        refine.to_vec()
+    };
+    let ps: Vec<u32> = if orders.is_empty() {
+        vec![0]
+    } else {
+        orders.to_vec()
+    };
+    let mut levels: Vec<(u32, u32)> = ks
+        .iter()
+        .flat_map(|k| ps.iter().map(move |p| (*k, *p)))
+        .collect();
+    levels.sort_by_key(|(k, p)| (k * p.max(&1), *k));
+    levels.dedup();
+    if let Some(w) = levels
+        .windows(2)
+        .find(|w| w[0].0 * w[0].1.max(1) == w[1].0 * w[1].1.max(1))
+    {
+        return Err(StudyError::Setup(format!(
+            "{} and {} have the same number of nodes per beam: a mesh ladder needs one level per size",
+            mesh_name(w[0].0, w[0].1),
+            mesh_name(w[1].0, w[1].1)
+        )));
+    }
+    Ok(levels)
+}
+
 /// Runs the space–time study of the deck at `path`.
 pub fn run_space_time(
     path: &Path,
@@ -186,22 +239,30 @@ pub fn run_space_time(
     let Analysis::Dynamic { alpha, end, .. } = base.analysis else {
         return Err(StudyError::Setup("a study needs a dynamic analysis".into()));
     };
-    let mut refine = opts.refine.clone();
-    refine.sort_unstable();
-    refine.dedup();
     let mut steps = opts.steps.clone();
     steps.sort_by(|a, b| b.total_cmp(a));
     steps.dedup();
-    if refine.len() < 3 || steps.len() < 3 {
-        return Err(StudyError::Setup(
-            "a space-time study needs at least three meshes (--refine) and three time steps \
-             (--steps): each variable's convergence is judged on two successive differences"
-                .into(),
-        ));
-    }
-    if refine[0] == 0 {
+    if opts.refine.contains(&0) {
         return Err(StudyError::Setup(
             "--refine factors must be at least 1".into(),
+        ));
+    }
+    if let Some(p) = opts
+        .orders
+        .iter()
+        .find(|p| **p == 0 || **p > crate::model::order::MAX_ORDER)
+    {
+        return Err(StudyError::Setup(format!(
+            "--order {p}: beam orders are 1 to {}",
+            crate::model::order::MAX_ORDER
+        )));
+    }
+    let meshes = mesh_levels(&opts.refine, &opts.orders)?;
+    if meshes.len() < 3 || steps.len() < 3 {
+        return Err(StudyError::Setup(
+            "a space-time study needs at least three meshes (--refine, --order) and three time \
+             steps (--steps): each variable's convergence is judged on two successive differences"
+                .into(),
         ));
     }
     for n in &opts.nodes {
@@ -216,10 +277,14 @@ pub fn run_space_time(
     let dt = steps[0];
     let mut runs = Vec::new();
     let mut records = Vec::new();
-    for &k in &refine {
+    for &(k, p) in &meshes {
         let mut m = base.clone();
         m.refine(k)
             .map_err(|e| StudyError::Setup(format!("--refine {k}: {e}")))?;
+        if p > 0 {
+            m.set_beam_order(p)
+                .map_err(|e| StudyError::Setup(format!("--order {p}: {e}")))?;
+        }
         let beams = m
             .elements
             .values()
@@ -233,7 +298,8 @@ pub fn run_space_time(
         for &h in &steps {
             set_run(&mut m, h, alpha, None, t_end);
             log(&format!(
-                "running refine {k} ({beams} beams), h = {h:.3e} s …"
+                "running {} ({beams} beams), h = {h:.3e} s …",
+                mesh_name(k, p)
             ));
             let mut rec = GridRecorder {
                 nodes: idx.clone(),
@@ -243,6 +309,7 @@ pub fn run_space_time(
             let report = solver::run(&m, &mut rec).map_err(|e| StudyError::Setup(e.to_string()))?;
             runs.push(GridRun {
                 refine: k,
+                order: p,
                 beams,
                 h,
                 stats: report.stats,
@@ -308,13 +375,12 @@ pub fn run_space_time(
             converged,
         }
     };
-    let nm = refine.len();
+    let nm = meshes.len();
     let space_idx: Vec<usize> = (0..nm).map(|m| at(m, ns - 1)).collect();
-    let space = ladder(
-        refine.iter().map(|k| f64::from(*k)).collect(),
-        space_idx,
-        &|i| f64::from(refine[i]) / f64::from(refine[i - 1]),
-    );
+    let measure = |i: usize| f64::from(meshes[i].0 * meshes[i].1.max(1));
+    let space = ladder((0..nm).map(measure).collect(), space_idx, &|i| {
+        measure(i) / measure(i - 1)
+    });
     let time_idx: Vec<usize> = (0..ns).map(|s| at(nm - 1, s)).collect();
     let time = ladder(steps.clone(), time_idx, &|i| steps[i - 1] / steps[i]);
     let reference = at(nm - 1, ns - 1);
@@ -376,6 +442,7 @@ mod tests {
     fn run(cpu: f64, error: f64) -> GridRun {
         GridRun {
             refine: 1,
+            order: 0,
             beams: 1,
             h: 1.0,
             stats: solver::Stats {

@@ -6,7 +6,12 @@ use std::io::{self, Write};
 use std::path::Path;
 
 fn label(r: &GridRun) -> String {
-    format!("refine {} ({} beams), h = {:.3e}", r.refine, r.beams, r.h)
+    format!(
+        "{} ({} beams), h = {:.3e}",
+        super::mesh_name(r.refine, r.order),
+        r.beams,
+        r.h
+    )
 }
 
 /// Writes `spacetime.csv` (one row per run), `spacetime_windows.csv` (per run and window),
@@ -18,6 +23,7 @@ pub fn write_space_time(r: &SpaceTimeReport, dir: &Path) -> io::Result<()> {
     let mut w = csv::Writer::from_path(dir.join("spacetime.csv"))?;
     w.write_record([
         "refine",
+        "order",
         "beam_elements",
         "h",
         "cpu_seconds",
@@ -31,6 +37,7 @@ pub fn write_space_time(r: &SpaceTimeReport, dir: &Path) -> io::Result<()> {
     for x in &r.runs {
         w.write_record([
             x.refine.to_string(),
+            x.order.to_string(),
             x.beams.to_string(),
             format!("{:e}", x.h),
             format!("{:.4}", x.stats.cpu_seconds),
@@ -46,6 +53,7 @@ pub fn write_space_time(r: &SpaceTimeReport, dir: &Path) -> io::Result<()> {
     let mut w = csv::Writer::from_path(dir.join("spacetime_windows.csv"))?;
     w.write_record([
         "refine",
+        "order",
         "h",
         "window_start",
         "error_position",
@@ -58,6 +66,7 @@ pub fn write_space_time(r: &SpaceTimeReport, dir: &Path) -> io::Result<()> {
         for (k, t) in r.windows.iter().enumerate() {
             w.write_record([
                 x.refine.to_string(),
+                x.order.to_string(),
                 format!("{:e}", x.h),
                 format!("{t}"),
                 csv_number(x.window_errors[k]),
@@ -72,6 +81,7 @@ pub fn write_space_time(r: &SpaceTimeReport, dir: &Path) -> io::Result<()> {
     let mut w = csv::Writer::from_path(dir.join("spacetime_peaks.csv"))?;
     w.write_record([
         "refine",
+        "order",
         "h",
         "node_index",
         "window_start",
@@ -85,6 +95,7 @@ pub fn write_space_time(r: &SpaceTimeReport, dir: &Path) -> io::Result<()> {
                 let Some(v) = p.get(k) else { continue };
                 w.write_record([
                     x.refine.to_string(),
+                    x.order.to_string(),
                     format!("{:e}", x.h),
                     n.to_string(),
                     format!("{t}"),
@@ -136,8 +147,10 @@ pub fn print_space_time(r: &SpaceTimeReport, out: &mut dyn Write) -> io::Result<
     let rf = &r.runs[r.runs.len() - 1];
     writeln!(
         out,
-        "space-time reference: refine {} ({} beams), h = {:.3e} s",
-        rf.refine, rf.beams, rf.h
+        "space-time reference: {} ({} beams), h = {:.3e} s",
+        super::mesh_name(rf.refine, rf.order),
+        rf.beams,
+        rf.h
     )?;
     writeln!(
         out,
@@ -165,7 +178,7 @@ pub fn print_space_time(r: &SpaceTimeReport, out: &mut dyn Write) -> io::Result<
         )?;
     }
     for (name, l, unit) in [
-        ("space: meshes at the finest step", &r.space, "refine"),
+        ("space: meshes at the finest step", &r.space, "k·p"),
         ("time: steps at the finest mesh", &r.time, "h (s)"),
     ] {
         writeln!(
@@ -275,13 +288,17 @@ fn draw_st<DB: plotters::prelude::DrawingBackend>(
         .draw()
         .map_err(|e| e.to_string())?;
     let colors = [BLUE, RED, GREEN, MAGENTA, CYAN, RGBColor(255, 140, 0)];
-    let mut meshes: Vec<(u32, usize)> = r.runs.iter().map(|x| (x.refine, x.beams)).collect();
+    let mut meshes: Vec<(u32, u32, usize)> = r
+        .runs
+        .iter()
+        .map(|x| (x.refine, x.order, x.beams))
+        .collect();
     meshes.dedup();
-    for (k, (refine, beams)) in meshes.iter().enumerate() {
+    for (k, (refine, order, beams)) in meshes.iter().enumerate() {
         let s: Vec<(f64, f64)> = r
             .runs
             .iter()
-            .filter(|x| x.refine == *refine)
+            .filter(|x| x.refine == *refine && x.order == *order)
             .filter(ok)
             .map(|x| (x.stats.cpu_seconds, x.error))
             .collect();
@@ -289,7 +306,10 @@ fn draw_st<DB: plotters::prelude::DrawingBackend>(
         chart
             .draw_series(LineSeries::new(s.clone(), col.stroke_width(2)))
             .map_err(|e| e.to_string())?
-            .label(format!("refine {refine} ({beams} beams), steps"))
+            .label(format!(
+                "{} ({beams} beams), steps",
+                super::mesh_name(*refine, *order)
+            ))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
         chart
             .draw_series(s.iter().map(|p| Circle::new(*p, 4, col.filled())))
