@@ -43,6 +43,7 @@ fn tip(model: &Model, h: &History, node: u32) -> Vector3<f64> {
 fn one_element_of_order_11_rolls_up_a_full_circle() {
     let m = deck("cantilever_rollup_p11.dat");
     assert_eq!(m.nodes.len(), 12, "2 user nodes + 10 generated");
+    assert_eq!(m.summary().generated.order_nodes, 10, "--check counts them");
     let h = run(&m, 1);
     let x = tip(&m, &h, 2);
     assert!(x.norm() < 2e-7, "tip {x} (L = 1 m)");

@@ -82,6 +82,9 @@ pub struct Generated {
     pub nodes: usize,
     /// Generated elements (numbered beyond the user's).
     pub elements: usize,
+    /// Interior nodes of beams of order > 1 (`ORDER p`, at the GLL points; numbered beyond
+    /// the user's and the divisions' nodes).
+    pub order_nodes: usize,
 }
 
 impl Model {
@@ -150,6 +153,7 @@ impl Model {
                     divided_beams: self.divisions.len(),
                     nodes,
                     elements,
+                    order_nodes: self.order_nodes.values().map(Vec::len).sum(),
                 }
             },
             analysis: match self.analysis {
@@ -184,6 +188,13 @@ impl fmt::Display for Summary {
                 f,
                 "generated:   {} nodes and {} elements, dividing {} beams (numbered beyond the deck's; the deck's nodes keep their numbers)",
                 g.nodes, g.elements, g.divided_beams
+            )?;
+        }
+        if g.order_nodes > 0 {
+            writeln!(
+                f,
+                "generated:   {} interior nodes of beams of order > 1 (ORDER; numbered beyond the deck's)",
+                g.order_nodes
             )?;
         }
         let eff = self.effects.names();
