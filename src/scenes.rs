@@ -48,23 +48,15 @@ pub fn pendulum_deck(elements_per_bar: usize, s: &PendulumSettings) -> String {
     let n = elements_per_bar.max(1);
     let (tip1, first2, tip2, floor) = (n + 2, n + 3, 2 * n + 3, 2 * n + 4);
     let (uj, contact, m1, m2) = (n + 2, 2 * n + 3, 2 * n + 4, 2 * n + 5);
-    // Bar 2's tip: (1, 0, 0) + (cos 30°, 0, sin 30°), as written in decks/pendulum.dat.
-    let (cx, cz) = (1.0 + 0.75f64.sqrt(), 0.5);
     let mut d = String::new();
     let w = &mut d;
-    let _ = writeln!(
-        w,
-        "TITLE double pendulum striking the floor - {n} elements per bar (E = {:e})\n",
-        s.young
-    );
-    let _ = writeln!(w, "MATERIALS\n  1  E {:e}  NU 0.3  RHO 7800\n", s.young);
-    let _ = writeln!(
-        w,
-        "SECTIONS\n  1  A 9e-4  I2 8.3e-8  I3 8.3e-8  J 4.15e-8  K 0.8333333333333334\n"
-    );
+    head(w, &format!("{n} elements per bar"), s);
     let _ = writeln!(w, "NODES\n  1   0 0 0  FIX ALL");
     let _ = writeln!(w, "  2 TO {tip1} LINE  0 0 0   1 0 0");
-    let _ = writeln!(w, "  {first2} TO {tip2} LINE  1 0 0   {cx:?} 0 {cz:?}");
+    let _ = writeln!(
+        w,
+        "  {first2} TO {tip2} LINE  1 0 0   {TIP2_X:?} 0 {TIP2_Z:?}"
+    );
     let _ = writeln!(w, "  {floor}  0 -1.8 0  FIX ALL\n");
     let _ = writeln!(w, "FUNCTIONS\n  1 TABLE  0 0  0.01 1  0.02 0\n");
     let _ = writeln!(w, "ELEMENTS\n  1  HINGE 1 2  AXIS 0 0 1");
@@ -84,6 +76,34 @@ pub fn pendulum_deck(elements_per_bar: usize, s: &PendulumSettings) -> String {
         range(n + 3, 2 * n + 2),
         first2 + 1
     );
+    tail(w, [tip1, tip2, floor], [uj, contact, m1, m2], s);
+    d
+}
+
+/// Bar 2's tip: (1, 0, 0) + (cos 30°, 0, sin 30°), as written in decks/pendulum.dat.
+const TIP2_X: f64 = 1.8660254037844386;
+const TIP2_Z: f64 = 0.5;
+
+/// TITLE, MATERIALS and SECTIONS of the seed scene (`what`: its mesh, in the title).
+fn head(w: &mut String, what: &str, s: &PendulumSettings) {
+    let _ = writeln!(
+        w,
+        "TITLE double pendulum striking the floor - {what} (E = {:e})\n",
+        s.young
+    );
+    let _ = writeln!(w, "MATERIALS\n  1  E {:e}  NU 0.3  RHO 7800\n", s.young);
+    let _ = writeln!(
+        w,
+        "SECTIONS\n  1  A 9e-4  I2 8.3e-8  I3 8.3e-8  J 4.15e-8  K 0.8333333333333334\n"
+    );
+}
+
+/// The seed scene's contact (the paper's eq. (17) as written: `CLIP OFF`), tip masses,
+/// loads, analysis, output and END, with the nodes `[tip 1, tip 2, floor]` and the
+/// elements `[universal joint, contact, mass 1, mass 2]` of the deck's numbering.
+fn tail(w: &mut String, nodes: [usize; 3], elements: [usize; 4], s: &PendulumSettings) {
+    let [tip1, tip2, floor] = nodes;
+    let [uj, contact, m1, m2] = elements;
     let _ = writeln!(
         w,
         "  {contact} CAME {floor} {tip2}  CAM LINE  FOLLOWER POINT  K 1e7  C 1e3  CLIP OFF"
@@ -107,7 +127,6 @@ pub fn pendulum_deck(elements_per_bar: usize, s: &PendulumSettings) -> String {
         let _ = writeln!(w, "OUTPUT NODES NONE ELEMENTS NONE");
     }
     let _ = writeln!(w, "END");
-    d
 }
 
 /// The seed scene with each bar ONE BEAM card of `ORDER order` divided in `divide` elements
@@ -116,24 +135,17 @@ pub fn pendulum_deck(elements_per_bar: usize, s: &PendulumSettings) -> String {
 /// (2), ujoint 12, bar 2 (13), contact 23, masses 24 and 25. The generated nodes are
 /// numbered from 25 on. `(10, 1)` is `decks/pendulum.dat`'s mesh with other numbers.
 pub fn pendulum_order_deck(divide: u32, order: u32, s: &PendulumSettings) -> String {
-    let (cx, cz) = (1.0 + 0.75f64.sqrt(), 0.5);
     let mut d = String::new();
     let w = &mut d;
-    let _ = writeln!(
-        w,
-        "TITLE double pendulum striking the floor - {divide} elements of order {order} per bar (E = {:e})\n",
-        s.young
-    );
-    let _ = writeln!(w, "MATERIALS\n  1  E {:e}  NU 0.3  RHO 7800\n", s.young);
-    let _ = writeln!(
-        w,
-        "SECTIONS\n  1  A 9e-4  I2 8.3e-8  I3 8.3e-8  J 4.15e-8  K 0.8333333333333334\n"
-    );
+    head(w, &format!("{divide} elements of order {order} per bar"), s);
     let _ = writeln!(
         w,
         "NODES\n  1   0 0 0  FIX ALL\n  2   0 0 0\n  12  1 0 0\n  13  1 0 0"
     );
-    let _ = writeln!(w, "  23  {cx:?} 0 {cz:?}\n  24  0 -1.8 0  FIX ALL\n");
+    let _ = writeln!(
+        w,
+        "  23  {TIP2_X:?} 0 {TIP2_Z:?}\n  24  0 -1.8 0  FIX ALL\n"
+    );
     let _ = writeln!(w, "FUNCTIONS\n  1 TABLE  0 0  0.01 1  0.02 0\n");
     let _ = writeln!(w, "ELEMENTS\n  1  HINGE 1 2  AXIS 0 0 1");
     let _ = writeln!(
@@ -145,23 +157,7 @@ pub fn pendulum_order_deck(divide: u32, order: u32, s: &PendulumSettings) -> Str
         w,
         "  13 BEAM 13 23  MAT 1 SEC 1 DIVIDE {divide} ORDER {order}"
     );
-    let _ = writeln!(w, "  23 CAME 24 23  CAM LINE  FOLLOWER POINT  K 1e7  C 1e3");
-    let _ = writeln!(w, "  24 MASS 12 M 1\n  25 MASS 23 M 1\n");
-    let _ = writeln!(
-        w,
-        "LOADS\n  GRAVITY 0 -9.81 0\n  MOMENT 2  0 0 -1000  FUNCTION 1\n"
-    );
-    let _ = writeln!(
-        w,
-        "ANALYSIS DYNAMIC ALPHA {:?} STEP {:e} END {:?}\n",
-        s.alpha, s.step, s.end
-    );
-    if s.output {
-        let _ = writeln!(w, "OUTPUT NODES 2 12 23 ELEMENTS 1 12 23 EVERY 10");
-    } else {
-        let _ = writeln!(w, "OUTPUT NODES NONE ELEMENTS NONE");
-    }
-    let _ = writeln!(w, "END");
+    tail(w, [12, 23, 24], [12, 23, 24, 25], s);
     d
 }
 
