@@ -24,7 +24,9 @@ use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factoriz
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
+mod factors;
 mod state;
+use factors::Factors;
 pub use state::LuState;
 
 /// Errors of the linear solver.
@@ -61,170 +63,6 @@ pub enum LuStrategy {
 /// usual choice for sparse LU: Duff, Erisman & Reid, §5.4; growth stays within (1 + 1/u)
 /// per elimination step).
 pub const PIVOT_THRESHOLD: f64 = 0.1;
-
-/// The simplicial factors `P A Q = L U` in our own storage (compressed columns, row
-/// indices sorted, in pivot order): strictly lower `L` (unit diagonal implied), strictly
-/// upper `U` and its diagonal, and where each entry of `A` goes.
-#[derive(Default)]
-struct Factors {
-    /// A factorisation with pivoting has filled the patterns.
-    valid: bool,
-    l_ptr: Vec<usize>,
-    l_row: Vec<usize>,
-    l_val: Vec<f64>,
-    u_ptr: Vec<usize>,
-    u_row: Vec<usize>,
-    u_val: Vec<f64>,
-    u_diag: Vec<f64>,
-    /// Row perm: `row_fwd[k]` = row of `A` pivoted at step k.
-    row_fwd: Vec<usize>,
-    /// Column order `Q`: `col_fwd[j]` = column of `A` eliminated at step j.
-    col_fwd: Vec<usize>,
-    /// Pivot-order row of each stored entry of `A`.
-    a_row: Vec<usize>,
-    /// Dense work vector (zero between uses).
-    work: Vec<f64>,
-    /// (row, value) buffer for sorting a column.
-    sort: Vec<(usize, f64)>,
-}
-
-impl Factors {
-    /// Copies faer's factors (rows unsorted, diagonals included) into sorted storage.
-    fn load(
-        &mut self,
-        lu: &SimplicialLu<usize, f64>,
-        row_fwd: &[usize],
-        row_inv: &[usize],
-        col_fwd: &[usize],
-        a_rows: &[usize],
-    ) {
-        let n = row_fwd.len();
-        let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
-        self.l_ptr.clear();
-        self.l_row.clear();
-        self.l_val.clear();
-        self.u_ptr.clear();
-        self.u_row.clear();
-        self.u_val.clear();
-        self.u_diag.clear();
-        self.l_ptr.push(0);
-        self.u_ptr.push(0);
-        for j in 0..n {
-            for (rows, vals, lower) in [
-                (l.row_idx_of_col_raw(j), l.val_of_col(j), true),
-                (u.row_idx_of_col_raw(j), u.val_of_col(j), false),
-            ] {
-                self.sort.clear();
-                for (&r, &v) in rows.iter().zip(vals) {
-                    if r == j {
-                        if !lower {
-                            self.u_diag.push(v);
-                        }
-                    } else {
-                        self.sort.push((r, v));
-                    }
-                }
-                self.sort.sort_unstable_by_key(|e| e.0);
-                let (row, val, ptr) = if lower {
-                    (&mut self.l_row, &mut self.l_val, &mut self.l_ptr)
-                } else {
-                    (&mut self.u_row, &mut self.u_val, &mut self.u_ptr)
-                };
-                for &(r, v) in &self.sort {
-                    row.push(r);
-                    val.push(v);
-                }
-                ptr.push(row.len());
-            }
-        }
-        self.row_fwd.clear();
-        self.row_fwd.extend_from_slice(row_fwd);
-        self.col_fwd.clear();
-        self.col_fwd.extend_from_slice(col_fwd);
-        self.a_row.clear();
-        self.a_row.extend(a_rows.iter().map(|&r| row_inv[r]));
-        self.work.clear();
-        self.work.resize(n, 0.0);
-        // The unchecked indexing of `solve` and `refactor` relies on this.
-        self.valid = self.u_diag.len() == n
-            && self.l_row.iter().chain(&self.u_row).all(|&r| r < n)
-            && self.a_row.iter().all(|&r| r < n);
-    }
-
-    /// Left-looking numeric LU of `A` (pattern `col_ptr`, values `values`) on the stored
-    /// pivots and patterns: for each column j of `P A Q`, `x = L⁻¹ a_j` over the known
-    /// pattern of `U(:, j)` (ascending rows are a topological order), then `u_jj = x_j`
-    /// and `L(:, j) = x / u_jj`. Returns false, with the factors invalid, if a pivot fails
-    /// the threshold test (or is zero or not finite).
-    fn refactor(&mut self, col_ptr: &[usize], values: &[f64]) -> bool {
-        let x = &mut self.work;
-        for (j, &pj) in self.col_fwd.iter().enumerate() {
-            for p in col_ptr[pj]..col_ptr[pj + 1] {
-                x[self.a_row[p]] += values[p];
-            }
-            for q in self.u_ptr[j]..self.u_ptr[j + 1] {
-                let k = self.u_row[q];
-                let xk = std::mem::take(&mut x[k]);
-                self.u_val[q] = xk;
-                let (a, b) = (self.l_ptr[k], self.l_ptr[k + 1]);
-                for (&i, &l) in self.l_row[a..b].iter().zip(&self.l_val[a..b]) {
-                    // SAFETY: `load` checked every stored row index against n = x.len().
-                    unsafe { *x.get_unchecked_mut(i) -= l * xk };
-                }
-            }
-            let d = std::mem::take(&mut x[j]);
-            let lower = self.l_ptr[j]..self.l_ptr[j + 1];
-            let cmax = self.l_row[lower.clone()]
-                .iter()
-                .fold(0.0f64, |m, &i| m.max(x[i].abs()));
-            if !(d.is_normal() && d.abs() >= PIVOT_THRESHOLD * cmax) {
-                x.iter_mut().for_each(|v| *v = 0.0);
-                self.valid = false;
-                return false;
-            }
-            self.u_diag[j] = d;
-            let inv = 1.0 / d;
-            for r in lower {
-                let i = self.l_row[r];
-                self.l_val[r] = std::mem::take(&mut x[i]) * inv;
-            }
-        }
-        true
-    }
-
-    /// Solves `A x = b` in place: `y = P b`, `L z = y`, `U w = z`, `x = Q w`.
-    fn solve(&mut self, rhs: &mut [f64]) {
-        let y = &mut self.work[..];
-        for (yk, &r) in y.iter_mut().zip(&self.row_fwd) {
-            *yk = rhs[r];
-        }
-        let n = y.len();
-        for j in 0..n {
-            let yj = y[j];
-            if yj != 0.0 {
-                let (a, b) = (self.l_ptr[j], self.l_ptr[j + 1]);
-                for (&i, &l) in self.l_row[a..b].iter().zip(&self.l_val[a..b]) {
-                    // SAFETY: `load` checked every stored row index against n = y.len().
-                    unsafe { *y.get_unchecked_mut(i) -= l * yj };
-                }
-            }
-        }
-        for j in (0..n).rev() {
-            let yj = y[j] / self.u_diag[j];
-            y[j] = yj;
-            if yj != 0.0 {
-                let (a, b) = (self.u_ptr[j], self.u_ptr[j + 1]);
-                for (&i, &u) in self.u_row[a..b].iter().zip(&self.u_val[a..b]) {
-                    // SAFETY: as above.
-                    unsafe { *y.get_unchecked_mut(i) -= u * yj };
-                }
-            }
-        }
-        for (yj, &c) in y.iter_mut().zip(&self.col_fwd) {
-            rhs[c] = std::mem::take(yj);
-        }
-    }
-}
 
 /// faer's simplicial factors of the last factorisation with pivoting, and its row
 /// permutation (forward, inverse).
@@ -603,5 +441,81 @@ mod tests {
         set(&mut s, [[1.0, 2.0], [2.0, 4.0]]);
         assert!(matches!(s.factor(), Err(LinearError::Singular(_))));
         assert!(s.solve(&mut [1.0, 1.0]).is_err());
+    }
+
+    #[test]
+    fn solves_by_runs_of_rows_give_the_bits_of_solves_entry_by_entry() {
+        // A dense 40×40 block with a sparse border (an element of order p couples 6(p + 1)
+        // unknowns; the joints' few equations come last): the factors have long runs of
+        // consecutive rows, which the solves and refactorisations then use; switching the
+        // runs off must change no bit.
+        let (n, b) = (48, 40);
+        let mut state = 7u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut cols = vec![Vec::new(); n];
+        let mut entries = Vec::new();
+        for c in 0..n {
+            let mut rows: Vec<usize> = if c < b {
+                (0..b).chain([b + c % (n - b)]).collect()
+            } else {
+                vec![c - b, c]
+            };
+            if c >= b {
+                rows.extend((0..b).filter(|r| r % (n - b) == c - b));
+            }
+            rows.sort_unstable();
+            rows.dedup();
+            for &r in &rows {
+                entries.push((r, c, next() + if r == c { 4.0 } else { 0.0 }));
+            }
+            cols[c] = rows;
+        }
+        let mut s = SparseSystem::with_strategy(&cols, LuStrategy::Simplicial).unwrap();
+        for &(r, c, v) in &entries {
+            let p = s.position(r, c).unwrap();
+            s.values[p] = v;
+        }
+        s.factor().unwrap();
+        assert!(
+            s.factors.l_runs.used && s.factors.u_runs.used,
+            "long runs expected"
+        );
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let solve = |s: &mut SparseSystem| {
+            let mut rhs = vec![0.0; n];
+            s.mul(&x, &mut rhs);
+            s.solve(&mut rhs).unwrap();
+            rhs
+        };
+        let by_runs = solve(&mut s);
+        let err = by_runs
+            .iter()
+            .zip(&x)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(err < 1e-12, "solution error {err}");
+        // A refactorisation on the kept pivots (new values, same pattern), by runs.
+        s.values.iter_mut().for_each(|v| *v *= 1.5);
+        s.factor().unwrap();
+        let refactored_by_runs = solve(&mut s);
+        // The same two factorisations and solves entry by entry.
+        let mut t = SparseSystem::with_strategy(&cols, LuStrategy::Simplicial).unwrap();
+        for &(r, c, v) in &entries {
+            let p = t.position(r, c).unwrap();
+            t.values[p] = v;
+        }
+        t.factor().unwrap();
+        t.factors.l_runs.used = false;
+        t.factors.u_runs.used = false;
+        assert_eq!(solve(&mut t), by_runs);
+        t.values.iter_mut().for_each(|v| *v *= 1.5);
+        t.factor().unwrap();
+        t.factors.l_runs.used = false;
+        t.factors.u_runs.used = false;
+        assert_eq!(solve(&mut t), refactored_by_runs);
     }
 }

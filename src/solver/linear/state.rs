@@ -102,6 +102,7 @@ impl SparseSystem {
         f.a_row = s.a_row;
         f.work.clear();
         f.work.resize(n, 0.0);
+        f.index_runs();
         Ok(())
     }
 }
