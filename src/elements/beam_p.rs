@@ -57,7 +57,7 @@
 
 use super::beam::{Beam, BeamProperties, default_axis2, reference_triad};
 use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
-use crate::dual::{Dual, Real};
+use crate::dual::Real;
 use crate::lagrange;
 use crate::model::ElementId;
 use crate::model::arc::Arc;
@@ -113,6 +113,8 @@ pub struct BeamP {
 #[derive(Default)]
 struct Scratch {
     shift: Vec<f64>,
+    /// `Λᵣᵀ Λᵢ = exp(ψ̃ᵢ)` of every node.
+    rel: Vec<Matrix3<f64>>,
     z: Vec<[f64; 6]>,
     gz: Vec<[f64; 6]>,
     jac: Vec<SMatrix<f64, 6, 12>>,
@@ -129,6 +131,7 @@ impl Scratch {
     fn size(&mut self, n: usize) {
         if self.z.len() < n {
             self.shift.resize(n, 0.0);
+            self.rel.resize(n, Matrix3::identity());
             self.z.resize(n, [0.0; 6]);
             self.gz.resize(n, [0.0; 6]);
             self.jac.resize(n, SMatrix::zeros());
@@ -137,32 +140,6 @@ impl Scratch {
             self.force.resize(n, [0.0; 6]);
         }
     }
-}
-
-/// `zᵢ = (yᵢ, ψᵢ)` of a node against the reference node, generic in the scalar: node `i` at
-/// `x`, `R exp(θ̃) Λ⁰`, the reference node at `x_r`, `R_r exp(θ̃_r) Λ⁰_r`; `shift = 2πk`
-/// selects the branch of the logarithm.
-#[allow(clippy::too_many_arguments)]
-fn local_vars<S: Real>(
-    x: &Vector3<S>,
-    th: &Vector3<S>,
-    xr: &Vector3<S>,
-    thr: &Vector3<S>,
-    r: &Matrix3<f64>,
-    rr: &Matrix3<f64>,
-    l0: &Matrix3<f64>,
-    l0r: &Matrix3<f64>,
-    shift: f64,
-) -> [S; 6] {
-    let li = rotation::mm(&rotation::mm(&r.map(c), &rotation::exp(th)), &l0.map(c));
-    let lr = rotation::mm(&rotation::mm(&rr.map(c), &rotation::exp(thr)), &l0r.map(c));
-    let mut psi = rotation::log(&rotation::mtm(&lr, &li));
-    if shift != 0.0 {
-        let n = psi.dot(&psi).sqrt();
-        psi *= S::one() + c::<S>(shift) / n;
-    }
-    let y = rotation::mtv(&lr, &(x - xr));
-    [y.x, y.y, y.z, psi.x, psi.y, psi.z]
 }
 
 /// Strains `(Λᵀ x_s, T(ψ) ψ_s)` (before subtracting the reference) from the local numbers
@@ -209,6 +186,11 @@ fn branch(phi: &Vector3<f64>, prev: &Vector3<f64>) -> f64 {
     let n = phi.norm();
     if n < 1e-8 {
         return 0.0; // the branches are 2π apart: no choice near the identity
+    }
+    // The branches φ̂(|φ| + 2πk) lie on a line 2π apart: |φₖ − prev| ≥ 2π|k| − |φ − prev|,
+    // so within π of `prev` the principal branch is the nearest (the usual case).
+    if (phi - prev).norm_squared() < PI * PI {
+        return 0.0;
     }
     let mut best = (f64::INFINITY, 0.0);
     for k in -3..=3 {
@@ -358,8 +340,9 @@ impl BeamP {
         let rest: Vec<NodeState> = x0.iter().map(|x| NodeState::at_rest(*x)).collect();
         let mut z = vec![[0.0; 6]; n];
         let mut shift = vec![0.0; n];
+        let mut rel = vec![Matrix3::identity(); n];
         let idx: Vec<usize> = (0..n).collect();
-        beam.locals(&rest, &idx, &mut z, &mut shift);
+        beam.locals(&rest, &idx, &mut z, &mut shift, &mut rel);
         let mut pts = std::mem::take(&mut beam.stiff);
         pts.push(beam.mid.clone());
         for q in &mut pts {
@@ -382,18 +365,26 @@ impl BeamP {
         self.length
     }
 
-    /// Local numbers `zᵢ` and branch shifts of every node (f64); `idx[k]` is node `k`'s index
-    /// into `nodes`.
-    fn locals(&self, nodes: &[NodeState], idx: &[usize], z: &mut [[f64; 6]], shift: &mut [f64]) {
+    /// Local numbers `zᵢ`, branch shifts and relative rotations `Λᵣᵀ Λᵢ` of every node
+    /// (f64); `idx[k]` is node `k`'s index into `nodes`.
+    fn locals(
+        &self,
+        nodes: &[NodeState],
+        idx: &[usize],
+        z: &mut [[f64; 6]],
+        shift: &mut [f64],
+        rel: &mut [Matrix3<f64>],
+    ) {
         let n = idx.len();
         let m = self.refn;
         let sr = &nodes[idx[m]];
         let lr = sr.r * self.lambda0[m];
-        let phi = |k: usize| rotation::log(&(lr.transpose() * nodes[idx[k]].r * self.lambda0[k]));
         z[m] = [0.0; 6];
         shift[m] = 0.0;
+        rel[m] = Matrix3::identity();
         let mut set = |k: usize, prev: Vector3<f64>| {
-            let f = phi(k);
+            rel[k] = lr.transpose() * nodes[idx[k]].r * self.lambda0[k];
+            let f = rotation::log(&rel[k]);
             let s = branch(&f, &prev);
             shift[k] = s;
             let psi = if s != 0.0 {
@@ -479,256 +470,33 @@ impl BeamP {
         ]
     }
 
+    /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
+    /// `tangent` their exact derivative into `out.tan` (module doc): the residual path
+    /// ([`residual`]) or the tangent path ([`tangent`]).
+    fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
+        if tangent {
+            self.internal_tangent(nodes, out)
+        } else {
+            self.internal_forces(nodes, out)
+        }
+    }
+
     /// Strains `Γ`, `K` at the element's midpoint `ξ = 0`.
     pub fn strains(&self, nodes: &[NodeState]) -> (Vector3<f64>, Vector3<f64>) {
         SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
             let n = self.nodes.len();
             s.size(n);
-            let Scratch { z, shift, .. } = &mut *s;
-            self.locals(nodes, &self.nodes, &mut z[..n], &mut shift[..n]);
+            let Scratch { z, shift, rel, .. } = &mut *s;
+            self.locals(
+                nodes,
+                &self.nodes,
+                &mut z[..n],
+                &mut shift[..n],
+                &mut rel[..n],
+            );
             let (g, k) = Self::strains_at(&self.mid, &z[..n]);
             (g - self.mid.gamma0, k - self.mid.kappa0)
-        })
-    }
-
-    /// Internal forces only (the residual path, evaluated at every Newton iteration): the
-    /// chain rule of the module doc with the Jacobian of the local numbers in closed form,
-    /// `∂yᵢ/∂xᵢ = Λᵣᵀ = −∂yᵢ/∂xᵣ`, `∂yᵢ/∂θᵣ = ỹᵢ Λ⁰ᵣᵀ`,
-    /// `∂ψᵢ/∂θᵢ = T⁻¹(ψᵢ) Λ⁰ᵢᵀ`, `∂ψᵢ/∂θᵣ = −T⁻¹(ψᵢ) exp(ψ̃ᵢ)ᵀ Λ⁰ᵣᵀ`
-    /// (from `exp(ψ̃ᵢ) = Λᵣᵀ Λᵢ`, `δ exp(ψ̃) = exp(ψ̃)(T(ψ) δψ)~`), and the gradient of each
-    /// point's energy density `∂e/∂y_s = exp(ψ̃) N`, `∂e/∂ψ_s = T(ψ)ᵀ M`, `∂e/∂ψ` by a
-    /// 3-direction dual number. Same numbers as the tangent path to round-off (tested).
-    fn internal_forces(&self, nodes: &[NodeState], out: &mut Local) {
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let n = self.nodes.len();
-            s.size(n);
-            let sc = &mut *s;
-            let m = self.refn;
-            self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
-            for g in sc.gz[..n].iter_mut() {
-                *g = [0.0; 6];
-            }
-            for q in &self.stiff {
-                let v = Self::point_vars(q, &sc.z[..n]);
-                let at = |k: usize, v: &[f64; 9]| Vector3::new(v[k], v[k + 1], v[k + 2]);
-                let g = self.density_grad(q, &v);
-                let (g_psi, g_dpsi, g_dy) = (at(0, &g), at(3, &g), at(6, &g));
-                for i in (0..n).filter(|&i| i != m) {
-                    for k in 0..3 {
-                        sc.gz[i][k] += q.wj * q.ds[i] * g_dy[k];
-                        sc.gz[i][3 + k] += q.wj * (q.n[i] * g_psi[k] + q.ds[i] * g_dpsi[k]);
-                    }
-                }
-            }
-            let sr = &nodes[self.nodes[m]];
-            let lr = sr.r * self.lambda0[m];
-            let l0r = &self.lambda0[m];
-            let (mut fxr, mut fthr) = (Vector3::zeros(), Vector3::zeros());
-            for i in (0..n).filter(|&i| i != m) {
-                let z = &sc.z[i];
-                let (y, psi) = (
-                    Vector3::new(z[0], z[1], z[2]),
-                    Vector3::new(z[3], z[4], z[5]),
-                );
-                let gy = Vector3::new(sc.gz[i][0], sc.gz[i][1], sc.gz[i][2]);
-                let gp = Vector3::new(sc.gz[i][3], sc.gz[i][4], sc.gz[i][5]);
-                let fx = lr * gy;
-                let tig = rotation::tangent_inv(&psi).transpose() * gp;
-                let fth = self.lambda0[i] * tig;
-                fxr -= fx;
-                fthr += l0r * (gy.cross(&y) - rotation::exp(&psi) * tig);
-                out.add_res(tx(i), &fx);
-                out.add_res(rx(i), &fth);
-            }
-            out.add_res(tx(m), &fxr);
-            out.add_res(rx(m), &fthr);
-        })
-    }
-
-    /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res`, and with
-    /// `tangent` their exact derivative into `out.tan` (module doc).
-    fn internal(&self, nodes: &[NodeState], tangent: bool, out: &mut Local) {
-        if !tangent {
-            return self.internal_forces(nodes, out);
-        }
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let n = self.nodes.len();
-            s.size(n);
-            let sc = &mut *s;
-            let m = self.refn;
-            self.locals(nodes, &self.nodes, &mut sc.z[..n], &mut sc.shift[..n]);
-            // Jacobians of the local numbers of every node but the reference, columns
-            // (xᵢ, θᵢ, xᵣ, θᵣ), in closed form (see `internal_forces`; ψ does not depend on positions).
-            let sr = &nodes[self.nodes[m]];
-            let lr = sr.r * self.lambda0[m];
-            let l0r = &self.lambda0[m];
-            for k in (0..n).filter(|&k| k != m) {
-                let l0 = &self.lambda0[k];
-                let z = &sc.z[k];
-                let (y, psi) = (
-                    Vector3::new(z[0], z[1], z[2]),
-                    Vector3::new(z[3], z[4], z[5]),
-                );
-                let ti = rotation::tangent_inv(&psi);
-                let dk = ti * l0.transpose();
-                let dr = -(ti * rotation::exp(&psi).transpose() * l0r.transpose());
-                let jac = &mut sc.jac[k];
-                *jac = SMatrix::zeros();
-                let yr = skew(&y) * l0r.transpose();
-                for r in 0..3 {
-                    for c in 0..3 {
-                        jac[(r, c)] = lr[(c, r)];
-                        jac[(r, 6 + c)] = -lr[(c, r)];
-                        jac[(r, 9 + c)] = yr[(r, c)];
-                        jac[(3 + r, 3 + c)] = dk[(r, c)];
-                        jac[(3 + r, 9 + c)] = dr[(r, c)];
-                    }
-                }
-            }
-            // Gradient (and Hessian) of Ũ in the local numbers.
-            for g in sc.gz[..n].iter_mut() {
-                *g = [0.0; 6];
-            }
-            for h in sc.ht[..n * n].iter_mut() {
-                *h = SMatrix::zeros();
-            }
-            for q in &self.stiff {
-                let v = Self::point_vars(q, &sc.z[..n]);
-                let vars: [Dual<9>; 9] = std::array::from_fn(|k| Dual::var(v[k], k));
-                let gd = self.density_grad(q, &vars);
-                let grad: [f64; 9] = std::array::from_fn(|k| gd[k].re);
-                let h = SMatrix::<f64, 9, 9>::from_fn(|r, c| gd[r].eps[c]);
-                for i in (0..n).filter(|&i| i != m) {
-                    for a in 0..3 {
-                        sc.gz[i][a] += q.wj * q.ds[i] * grad[6 + a];
-                        sc.gz[i][3 + a] += q.wj * (q.n[i] * grad[a] + q.ds[i] * grad[3 + a]);
-                    }
-                }
-                {
-                    // hp_j = h P_j (9×6), then H̃_ij += wJ P_iᵀ hp_j.
-                    for j in (0..n).filter(|&j| j != m) {
-                        let hp = &mut sc.hp[j];
-                        for r in 0..9 {
-                            for a in 0..3 {
-                                hp[(r, a)] = q.ds[j] * h[(r, 6 + a)];
-                                hp[(r, 3 + a)] = q.n[j] * h[(r, a)] + q.ds[j] * h[(r, 3 + a)];
-                            }
-                        }
-                    }
-                    for i in (0..n).filter(|&i| i != m) {
-                        for j in (0..n).filter(|&j| j != m) {
-                            let hp = &sc.hp[j];
-                            let ht = &mut sc.ht[i * n + j];
-                            for col in 0..6 {
-                                for a in 0..3 {
-                                    ht[(a, col)] += q.wj * q.ds[i] * hp[(6 + a, col)];
-                                    ht[(3 + a, col)] +=
-                                        q.wj * (q.n[i] * hp[(a, col)] + q.ds[i] * hp[(3 + a, col)]);
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            // Forces f = Zᵀ ∇Ũ: node k's columns 0..6 of its Jacobian, the reference node's 6..12.
-            for f in sc.force[..n].iter_mut() {
-                *f = [0.0; 6];
-            }
-            for k in (0..n).filter(|&k| k != m) {
-                for col in 0..12 {
-                    let v: f64 = (0..6).map(|a| sc.jac[k][(a, col)] * sc.gz[k][a]).sum();
-                    let node = if col < 6 { k } else { m };
-                    sc.force[node][col % 6] += v;
-                }
-            }
-            for (k, f) in sc.force[..n].iter().enumerate() {
-                for a in 0..6 {
-                    out.res[6 * k + a] += f[a];
-                }
-            }
-            let nl = out.n;
-            let loc = |k: usize, col: usize| {
-                if col < 6 {
-                    6 * k + col
-                } else {
-                    6 * m + col - 6
-                }
-            };
-            // Zᵀ H̃ Z.
-            for i in (0..n).filter(|&i| i != m) {
-                for j in (0..n).filter(|&j| j != m) {
-                    let b = sc.jac[i].transpose() * sc.ht[i * n + j] * sc.jac[j];
-                    for col in 0..12 {
-                        let cc = loc(j, col);
-                        for row in 0..12 {
-                            out.tan[cc * nl + loc(i, row)] += b[(row, col)];
-                        }
-                    }
-                }
-            }
-            // Σₐ (∇Ũ)ₐ ∇²zₐ. ψ: the dual Hessians in (θᵢ, θᵣ). y = Λ⁰ᵣᵀ exp(−θ̃ᵣ) Rᵣᵀ (xᵢ − xᵣ):
-            // with u = Λ⁰ᵣ g_y, w = Rᵣᵀ(xᵢ − xᵣ), g_y·y = u·exp(−θ̃ᵣ) w has the Hessian
-            // ½(u wᵀ + w uᵀ) − (u·w) I in θᵣ and ũ Rᵣᵀ in (θᵣ, xᵢ) (−ũ Rᵣᵀ in (θᵣ, xᵣ)).
-            for k in (0..n).filter(|&k| k != m) {
-                let gz = &sc.gz[k];
-                let mut sec = SMatrix::<f64, 12, 12>::zeros();
-                // Σₐ g_ψₐ ∇²ψₐ in (θᵢ, θᵣ): the derivative at θ = 0 of the gradient of g_ψ·ψ in
-                // the additive chart, G(θ) = [T(θᵢ)ᵀ Λ⁰ᵢ T⁻ᵀ(ψ) g_ψ; −T(θᵣ)ᵀ Λ⁰ᵣ exp(ψ̃) T⁻ᵀ(ψ) g_ψ]
-                // (`R exp(θ̃ + δ̃) = R exp(θ̃) exp((T(θ)δ)~)`), by 6-direction dual numbers.
-                {
-                    type D = Dual<6>;
-                    let st = &nodes[self.nodes[k]];
-                    let (l0, sh) = (&self.lambda0[k], sc.shift[k]);
-                    let th = Vector3::from_fn(|a, _| D::var(0.0, a));
-                    let thr = Vector3::from_fn(|a, _| D::var(0.0, 3 + a));
-                    let zero = Vector3::from_element(D::constant(0.0));
-                    let lv = local_vars(&zero, &th, &zero, &thr, &st.r, &sr.r, l0, l0r, sh);
-                    let psi = Vector3::new(lv[3], lv[4], lv[5]);
-                    let gpsi: Vector3<D> = Vector3::new(gz[3], gz[4], gz[5]).map(D::constant);
-                    let w = rotation::mtv(&rotation::tangent_inv(&psi), &gpsi);
-                    let gk = rotation::mtv(&rotation::tangent(&th), &rotation::mv(&l0.map(c), &w));
-                    let gr = -rotation::mtv(
-                        &rotation::tangent(&thr),
-                        &rotation::mv(&l0r.map(c), &rotation::mv(&rotation::exp(&psi), &w)),
-                    );
-                    for r in 0..3 {
-                        for col in 0..6 {
-                            let cc = col + 3 + 3 * (col / 3);
-                            sec[(3 + r, cc)] += gk[r].eps[col];
-                            sec[(9 + r, cc)] += gr[r].eps[col];
-                        }
-                    }
-                }
-                let gy = Vector3::new(gz[0], gz[1], gz[2]);
-                let u = l0r * gy;
-                let w = sr.r.transpose() * (nodes[self.nodes[k]].x - sr.x);
-                let hrr =
-                    (u * w.transpose() + w * u.transpose()) * 0.5 - Matrix3::identity() * u.dot(&w);
-                let mix = skew(&u) * sr.r.transpose();
-                for r in 0..3 {
-                    for c in 0..3 {
-                        sec[(9 + r, 9 + c)] += hrr[(r, c)];
-                        sec[(9 + r, c)] += mix[(r, c)];
-                        sec[(9 + r, 6 + c)] -= mix[(r, c)];
-                        sec[(c, 9 + r)] += mix[(r, c)];
-                        sec[(6 + c, 9 + r)] -= mix[(r, c)];
-                    }
-                }
-                for col in 0..12 {
-                    let cc = loc(k, col);
-                    for row in 0..12 {
-                        out.tan[cc * nl + loc(k, row)] += sec[(row, col)];
-                    }
-                }
-            }
-            // ½ f̃_Θ on the rotation diagonal blocks.
-            for (k, f) in sc.force[..n].iter().enumerate() {
-                let half = skew(&Vector3::new(f[3], f[4], f[5])) * 0.5;
-                out.add_block(rx(k), rx(k), &half);
-            }
         })
     }
 }
@@ -799,8 +567,14 @@ impl Element for BeamP {
         let strain = SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
             s.size(n);
-            let Scratch { z, shift, .. } = &mut *s;
-            self.locals(nodes, &self.nodes, &mut z[..n], &mut shift[..n]);
+            let Scratch { z, shift, rel, .. } = &mut *s;
+            self.locals(
+                nodes,
+                &self.nodes,
+                &mut z[..n],
+                &mut shift[..n],
+                &mut rel[..n],
+            );
             self.stiff
                 .iter()
                 .map(|q| q.wj * self.density(q, &Self::point_vars(q, &z[..n])))
@@ -847,6 +621,9 @@ impl Element for BeamP {
         }
     }
 }
+
+mod residual;
+mod tangent;
 
 #[cfg(test)]
 #[path = "beam_p_tests.rs"]
