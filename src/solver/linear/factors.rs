@@ -76,44 +76,22 @@ impl Runs {
         self.simd = Simd::detect();
     }
 
-    /// `y[rows of column j] −= vals · yj`, run by run, with the widest vectors the CPU has
-    /// (the same multiplications and subtractions lane by lane, so the same bits on any
-    /// CPU: no fused multiply–add).
+    /// `y[rows of column j] −= vals · yj`, run by run (compiled into each of
+    /// [`Factors`]' vector variants: see [`Simd`]).
     #[inline(always)]
     fn update(&self, j: usize, vals: &[f64], y: &mut [f64], yj: f64) {
-        #[cfg(target_arch = "x86_64")]
-        match self.simd {
-            // SAFETY: `simd` was set from the CPU's feature detection in `build`.
-            Simd::Avx512 => return unsafe { self.update_avx512(j, vals, y, yj) },
-            Simd::Avx2 => return unsafe { self.update_avx2(j, vals, y, yj) },
-            Simd::Base => {}
-        }
-        self.update_base(j, vals, y, yj)
-    }
-
-    #[inline(always)]
-    fn update_base(&self, j: usize, vals: &[f64], y: &mut [f64], yj: f64) {
         for &(r, o, len) in &self.run[self.ptr[j]..self.ptr[j + 1]] {
             for (yi, &v) in y[r..r + len].iter_mut().zip(&vals[o..o + len]) {
                 *yi -= v * yj;
             }
         }
     }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn update_avx2(&self, j: usize, vals: &[f64], y: &mut [f64], yj: f64) {
-        self.update_base(j, vals, y, yj)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn update_avx512(&self, j: usize, vals: &[f64], y: &mut [f64], yj: f64) {
-        self.update_base(j, vals, y, yj)
-    }
 }
 
-/// The vector instructions of [`Runs::update`], detected at run time.
+/// The widest vector instructions of the CPU, detected at run time: the solves and the
+/// refactorisation are compiled once per set ([`Factors::solve`], [`Factors::refactor`]),
+/// the runs' updates inlined into them. The same multiplications and subtractions lane by
+/// lane (no fused multiply–add), so the same bits on any CPU.
 #[derive(Default, Clone, Copy)]
 enum Simd {
     #[default]
@@ -216,6 +194,30 @@ impl Factors {
     /// and `L(:, j) = x / u_jj`. Returns false, with the factors invalid, if a pivot fails
     /// the threshold test (or is zero or not finite).
     pub(super) fn refactor(&mut self, col_ptr: &[usize], values: &[f64]) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        match self.l_runs.simd {
+            // SAFETY: `simd` comes from the CPU's feature detection (`Simd::detect`).
+            Simd::Avx512 => return unsafe { self.refactor_avx512(col_ptr, values) },
+            Simd::Avx2 => return unsafe { self.refactor_avx2(col_ptr, values) },
+            Simd::Base => {}
+        }
+        self.refactor_impl(col_ptr, values)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn refactor_avx512(&mut self, col_ptr: &[usize], values: &[f64]) -> bool {
+        self.refactor_impl(col_ptr, values)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn refactor_avx2(&mut self, col_ptr: &[usize], values: &[f64]) -> bool {
+        self.refactor_impl(col_ptr, values)
+    }
+
+    #[inline(always)]
+    fn refactor_impl(&mut self, col_ptr: &[usize], values: &[f64]) -> bool {
         let x = &mut self.work;
         for (j, &pj) in self.col_fwd.iter().enumerate() {
             for p in col_ptr[pj]..col_ptr[pj + 1] {
@@ -257,6 +259,30 @@ impl Factors {
 
     /// Solves `A x = b` in place: `y = P b`, `L z = y`, `U w = z`, `x = Q w`.
     pub(super) fn solve(&mut self, rhs: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        match self.l_runs.simd {
+            // SAFETY: `simd` comes from the CPU's feature detection (`Simd::detect`).
+            Simd::Avx512 => return unsafe { self.solve_avx512(rhs) },
+            Simd::Avx2 => return unsafe { self.solve_avx2(rhs) },
+            Simd::Base => {}
+        }
+        self.solve_impl(rhs)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn solve_avx512(&mut self, rhs: &mut [f64]) {
+        self.solve_impl(rhs)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn solve_avx2(&mut self, rhs: &mut [f64]) {
+        self.solve_impl(rhs)
+    }
+
+    #[inline(always)]
+    fn solve_impl(&mut self, rhs: &mut [f64]) {
         let y = &mut self.work[..];
         for (yk, &r) in y.iter_mut().zip(&self.row_fwd) {
             *yk = rhs[r];
