@@ -409,11 +409,11 @@ impl BeamP {
     /// The nine local numbers `(ψ, ψ_s, y_s)` of a point.
     fn point_vars(q: &Point, z: &[[f64; 6]]) -> [f64; 9] {
         let mut v = [0.0; 9];
-        for (i, zi) in z.iter().enumerate() {
+        for ((zi, &ni), &di) in z.iter().zip(&q.n).zip(&q.ds) {
             for a in 0..3 {
-                v[a] += q.n[i] * zi[3 + a];
-                v[3 + a] += q.ds[i] * zi[3 + a];
-                v[6 + a] += q.ds[i] * zi[a];
+                v[a] += ni * zi[3 + a];
+                v[3 + a] += di * zi[3 + a];
+                v[6 + a] += di * zi[a];
             }
         }
         v

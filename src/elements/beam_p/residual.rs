@@ -86,11 +86,13 @@ impl BeamP {
                 let v = Self::point_vars(q, &sc.z[..n]);
                 let at = |k: usize, v: &[f64; 9]| Vector3::new(v[k], v[k + 1], v[k + 2]);
                 let g = self.density_grad_f64(q, &v);
-                let (g_psi, g_dpsi, g_dy) = (at(0, &g), at(3, &g), at(6, &g));
-                for i in (0..n).filter(|&i| i != m) {
+                let (g_psi, g_dpsi, g_dy) = (at(0, &g) * q.wj, at(3, &g) * q.wj, at(6, &g) * q.wj);
+                // Every node, the reference node's entry included (unused: its forces
+                // follow from the others').
+                for ((gz, &ni), &di) in sc.gz[..n].iter_mut().zip(&q.n).zip(&q.ds) {
                     for k in 0..3 {
-                        sc.gz[i][k] += q.wj * q.ds[i] * g_dy[k];
-                        sc.gz[i][3 + k] += q.wj * (q.n[i] * g_psi[k] + q.ds[i] * g_dpsi[k]);
+                        gz[k] += di * g_dy[k];
+                        gz[3 + k] += ni * g_psi[k] + di * g_dpsi[k];
                     }
                 }
             }

@@ -99,26 +99,35 @@ impl BeamP {
                     }
                 }
                 {
-                    // hp_j = h P_j (9×6), then H̃_ij += wJ P_iᵀ hp_j.
+                    // hp_j = h P_j (9×6), then H̃_ij += wJ P_iᵀ hp_j (column-major slices:
+                    // h[c·9 + r], hp[c·9 + r], H̃[c·6 + r]).
+                    let hs = h.as_slice();
                     for j in (0..n).filter(|&j| j != m) {
-                        let hp = &mut sc.hp[j];
-                        for r in 0..9 {
-                            for a in 0..3 {
-                                hp[(r, a)] = q.ds[j] * h[(r, 6 + a)];
-                                hp[(r, 3 + a)] = q.n[j] * h[(r, a)] + q.ds[j] * h[(r, 3 + a)];
+                        let (dj, nj) = (q.ds[j], q.n[j]);
+                        let hp = sc.hp[j].as_mut_slice();
+                        for a in 0..3 {
+                            let (cy, cp, cs) = (
+                                &hs[(6 + a) * 9..][..9],
+                                &hs[a * 9..][..9],
+                                &hs[(3 + a) * 9..][..9],
+                            );
+                            for r in 0..9 {
+                                hp[a * 9 + r] = dj * cy[r];
+                                hp[(3 + a) * 9 + r] = nj * cp[r] + dj * cs[r];
                             }
                         }
                     }
                     // H̃ is symmetric: the blocks j ≥ i here, the others mirrored below.
                     for i in (0..n).filter(|&i| i != m) {
+                        let (wd, wn) = (q.wj * q.ds[i], q.wj * q.n[i]);
                         for j in (i..n).filter(|&j| j != m) {
-                            let hp = &sc.hp[j];
-                            let ht = &mut sc.ht[i * n + j];
+                            let hp = sc.hp[j].as_slice();
+                            let ht = sc.ht[i * n + j].as_mut_slice();
                             for col in 0..6 {
+                                let (h, t) = (&hp[col * 9..][..9], &mut ht[col * 6..][..6]);
                                 for a in 0..3 {
-                                    ht[(a, col)] += q.wj * q.ds[i] * hp[(6 + a, col)];
-                                    ht[(3 + a, col)] +=
-                                        q.wj * (q.n[i] * hp[(a, col)] + q.ds[i] * hp[(3 + a, col)]);
+                                    t[a] += wd * h[6 + a];
+                                    t[3 + a] += wn * h[a] + wd * h[3 + a];
                                 }
                             }
                         }
