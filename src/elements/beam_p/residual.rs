@@ -109,7 +109,7 @@ impl BeamP {
                 let gy = Vector3::new(sc.gz[i][0], sc.gz[i][1], sc.gz[i][2]);
                 let gp = Vector3::new(sc.gz[i][3], sc.gz[i][4], sc.gz[i][5]);
                 let fx = lr * gy;
-                let tig = rotation::tangent_inv(&psi).transpose() * gp;
+                let tig = rotation::mtv(&rotation::tangent_inv(&psi), &gp);
                 let fth = self.lambda0[i] * tig;
                 fxr -= fx;
                 fthr += l0r * (gy.cross(&y) - sc.rel[i] * tig);
