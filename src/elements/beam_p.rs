@@ -406,6 +406,26 @@ impl BeamP {
         }
     }
 
+    /// Runs `f` on this thread's scratch buffers, sized for the element's `n` nodes and
+    /// holding the local numbers, branch shifts and relative rotations of `nodes`
+    /// ([`Self::locals`]).
+    fn with_locals<R>(&self, nodes: &[NodeState], f: impl FnOnce(&mut Scratch, usize) -> R) -> R {
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let n = self.nodes.len();
+            s.size(n);
+            let sc = &mut *s;
+            self.locals(
+                nodes,
+                &self.nodes,
+                &mut sc.z[..n],
+                &mut sc.shift[..n],
+                &mut sc.rel[..n],
+            );
+            f(sc, n)
+        })
+    }
+
     /// The nine local numbers `(ψ, ψ_s, y_s)` of a point.
     fn point_vars(q: &Point, z: &[[f64; 6]]) -> [f64; 9] {
         let mut v = [0.0; 9];
@@ -483,19 +503,8 @@ impl BeamP {
 
     /// Strains `Γ`, `K` at the element's midpoint `ξ = 0`.
     pub fn strains(&self, nodes: &[NodeState]) -> (Vector3<f64>, Vector3<f64>) {
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let n = self.nodes.len();
-            s.size(n);
-            let Scratch { z, shift, rel, .. } = &mut *s;
-            self.locals(
-                nodes,
-                &self.nodes,
-                &mut z[..n],
-                &mut shift[..n],
-                &mut rel[..n],
-            );
-            let (g, k) = Self::strains_at(&self.mid, &z[..n]);
+        self.with_locals(nodes, |sc, n| {
+            let (g, k) = Self::strains_at(&self.mid, &sc.z[..n]);
             (g - self.mid.gamma0, k - self.mid.kappa0)
         })
     }
@@ -564,17 +573,8 @@ impl Element for BeamP {
 
     fn energies(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> Energies {
         let n = self.nodes.len();
-        let strain = SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            s.size(n);
-            let Scratch { z, shift, rel, .. } = &mut *s;
-            self.locals(
-                nodes,
-                &self.nodes,
-                &mut z[..n],
-                &mut shift[..n],
-                &mut rel[..n],
-            );
+        let strain = self.with_locals(nodes, |sc, n| {
+            let z = &sc.z;
             self.stiff
                 .iter()
                 .map(|q| q.wj * self.density(q, &Self::point_vars(q, &z[..n])))

@@ -335,18 +335,23 @@ mod tests {
         assert!((b[1] + 2.0).abs() < 1e-14);
     }
 
+    /// Values in [−0.5, 0.5) from a linear congruential sequence seeded by `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
     /// A deterministic sparse unsymmetric matrix: a band of 3 plus a few far entries, with
     /// values from a linear congruential sequence seeded by `seed`.
     type Entries = Vec<(usize, usize, f64)>;
 
     fn banded(n: usize, seed: u64) -> (Vec<Vec<usize>>, Entries) {
-        let mut state = seed;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(seed);
         let mut cols = vec![Vec::new(); n];
         let mut entries = Vec::new();
         for c in 0..n {
@@ -450,13 +455,7 @@ mod tests {
         // consecutive rows, which the solves and refactorisations then use; switching the
         // runs off must change no bit.
         let (n, b) = (48, 40);
-        let mut state = 7u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(7);
         let mut cols = vec![Vec::new(); n];
         let mut entries = Vec::new();
         for c in 0..n {

@@ -1,7 +1,7 @@
 //! The residual path of [`BeamP`] (every Newton iteration): internal forces only, in `f64`,
 //! with the Jacobian of the local numbers in closed form and one `sin`/`cos` per point.
 
-use super::{BeamP, Point, SCRATCH, t_coefficients};
+use super::{BeamP, Point, t_coefficients};
 use crate::elements::{Local, NodeState, rx, tx};
 use nalgebra::Vector3;
 
@@ -79,19 +79,8 @@ impl BeamP {
     /// point's energy density `∂e/∂y_s = exp(ψ̃) N`, `∂e/∂ψ_s = T(ψ)ᵀ M`, `∂e/∂ψ` by a
     /// 3-direction dual number. Same numbers as the tangent path to round-off (tested).
     pub(super) fn internal_forces(&self, nodes: &[NodeState], out: &mut Local) {
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let n = self.nodes.len();
-            s.size(n);
-            let sc = &mut *s;
+        self.with_locals(nodes, |sc, n| {
             let m = self.refn;
-            self.locals(
-                nodes,
-                &self.nodes,
-                &mut sc.z[..n],
-                &mut sc.shift[..n],
-                &mut sc.rel[..n],
-            );
             for g in sc.gz[..n].iter_mut() {
                 *g = [0.0; 6];
             }

@@ -2,7 +2,7 @@
 //! the iteration matrix is rebuilt (module doc of [`super`]: `∇²U = Zᵀ ∇²Ũ Z + Σₐ (∇Ũ)ₐ ∇²zₐ`
 //! plus the Baker–Campbell–Hausdorff term).
 
-use super::{BeamP, SCRATCH};
+use super::BeamP;
 use crate::dual::{Dual, Real};
 use crate::elements::{Local, NodeState, rx};
 use crate::rotation::{self, c, skew};
@@ -38,19 +38,8 @@ impl BeamP {
     /// Internal forces (node-by-node `[f_x, f_Θ]`, `Θ` material) into `out.res` and their
     /// exact derivative into `out.tan` (module doc of [`super`]).
     pub(super) fn internal_tangent(&self, nodes: &[NodeState], out: &mut Local) {
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let n = self.nodes.len();
-            s.size(n);
-            let sc = &mut *s;
+        self.with_locals(nodes, |sc, n| {
             let m = self.refn;
-            self.locals(
-                nodes,
-                &self.nodes,
-                &mut sc.z[..n],
-                &mut sc.shift[..n],
-                &mut sc.rel[..n],
-            );
             // Jacobians of the local numbers of every node but the reference, columns
             // (xᵢ, θᵢ, xᵣ, θᵣ), in closed form (see `internal_forces`; ψ does not depend on positions).
             let sr = &nodes[self.nodes[m]];
