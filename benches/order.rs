@@ -6,7 +6,6 @@
 //! cost at a fixed order must grow at most linearly with the nodes).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use mecano::elements::EvalContext;
 use mecano::scenes::{PendulumSettings, pendulum_order_deck};
 use mecano::solver::Integrator;
 use std::hint::black_box;
@@ -41,17 +40,6 @@ fn advanced(divide: u32, order: u32, steps: usize) -> Integrator {
     integ
 }
 
-fn step_context(integ: &Integrator, h: f64) -> EvalContext {
-    let p = integ.hht;
-    EvalContext {
-        c_v: p.gamma / (p.beta * h),
-        c_a: 1.0 / ((1.0 - p.alpha_f) * p.beta * h * h),
-        h,
-        t: integ.t + h,
-        ..integ.current_context()
-    }
-}
-
 fn id(d: u32, p: u32) -> BenchmarkId {
     BenchmarkId::from_parameter(format!("p{p}_d{d}_nodes{}", d * p + 1))
 }
@@ -61,7 +49,7 @@ fn assembly(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("order_{name}"));
         for (d, p) in MESHES {
             let mut integ = advanced(d, p, 100);
-            let ctx = step_context(&integ, H);
+            let ctx = integ.step_context(H);
             let (nodes, lambda) = (integ.nodes.clone(), integ.lambda.clone());
             g.bench_function(id(d, p), |b| {
                 b.iter(|| black_box(integ.sys.assemble(&ctx, &nodes, &lambda, tangent)))

@@ -8,7 +8,6 @@
 //! set `MECANO_BENCH_RUN_ALL=1` to time 40 and 80 too (minutes per size).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use mecano::elements::EvalContext;
 use mecano::scenes::{PendulumSettings, pendulum_deck};
 use mecano::solver::{Integrator, Observer, Snapshot};
 use std::hint::black_box;
@@ -36,23 +35,11 @@ fn advanced(n: usize, steps: usize) -> Integrator {
     integ
 }
 
-/// The HHT context of a step of size `h` from the integrator's current state.
-fn step_context(integ: &Integrator, h: f64) -> EvalContext {
-    let p = integ.hht;
-    EvalContext {
-        c_v: p.gamma / (p.beta * h),
-        c_a: 1.0 / ((1.0 - p.alpha_f) * p.beta * h * h),
-        h,
-        t: integ.t + h,
-        ..integ.current_context()
-    }
-}
-
 fn assembly(c: &mut Criterion) {
     let mut g = c.benchmark_group("assembly");
     for n in SIZES {
         let mut integ = advanced(n, 100);
-        let ctx = step_context(&integ, H);
+        let ctx = integ.step_context(H);
         let (nodes, lambda) = (integ.nodes.clone(), integ.lambda.clone());
         g.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter(|| black_box(integ.sys.assemble(&ctx, &nodes, &lambda, true)))
@@ -65,7 +52,7 @@ fn factor_solve(c: &mut Criterion) {
     let mut g = c.benchmark_group("factor_solve");
     for n in SIZES {
         let mut integ = advanced(n, 100);
-        let ctx = step_context(&integ, H);
+        let ctx = integ.step_context(H);
         let (nodes, lambda) = (integ.nodes.clone(), integ.lambda.clone());
         integ.sys.assemble(&ctx, &nodes, &lambda, true);
         let rhs = integ.sys.rhs.clone();

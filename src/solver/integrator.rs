@@ -793,6 +793,13 @@ impl Integrator {
         self.context(self.t, 0.0, self.scale)
     }
 
+    /// The evaluation context of a step of size `h` from the current state: time `t + h`
+    /// and the HHT coefficients `c_v = γ/(βh)`, `c_a = 1/((1 − α_f)βh²)` the step uses
+    /// (for benchmarks and tools that assemble outside [`Self::try_step`]).
+    pub fn step_context(&self, h: f64) -> EvalContext {
+        self.context(self.t + h, h, self.scale)
+    }
+
     /// Largest constraint violation over all elements at the current state.
     pub fn constraint_violation(&self) -> f64 {
         self.sys
