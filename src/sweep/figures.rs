@@ -13,41 +13,11 @@
 //! value, their ticks labelled with the value.
 
 use super::SweepError;
+use super::collect::values_of;
 use super::plan::{Plan, Variation};
 use super::runner::{CaseRecord, Status};
 use plotters::prelude::*;
-use serde::Deserialize;
 use std::path::PathBuf;
-
-/// Published or reference points drawn on a 1-D sweep's figure.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Reference {
-    /// The quantity (y).
-    pub quantity: String,
-    /// The parameter (x).
-    pub parameter: String,
-    /// Legend.
-    pub label: String,
-    /// (x, y) pairs.
-    pub points: Vec<[f64; 2]>,
-}
-
-/// A power-law guide y = y0 (x / x0)^exponent.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Guide {
-    /// The quantity (y).
-    pub quantity: String,
-    /// The parameter (x).
-    pub parameter: String,
-    /// Legend.
-    pub label: String,
-    /// The exponent.
-    pub exponent: f64,
-    /// The point (x0, y0) it passes through.
-    pub through: [f64; 2],
-}
 
 struct Axis {
     log: bool,
@@ -368,7 +338,7 @@ pub fn draw(plan: &Plan, records: &[CaseRecord]) -> Result<Vec<PathBuf>, SweepEr
         .collect();
     if !random.is_empty() {
         for (k, q) in plan.quantities.iter().enumerate() {
-            let x = super::collect::values_of(records, k);
+            let x = values_of(records, k);
             if x.is_empty() {
                 continue;
             }

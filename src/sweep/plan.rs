@@ -70,9 +70,9 @@ struct PlanFile {
     #[serde(default)]
     quantity: Vec<QuantitySpec>,
     #[serde(default)]
-    reference: Vec<super::figures::Reference>,
+    reference: Vec<Reference>,
     #[serde(default)]
-    guide: Vec<super::figures::Guide>,
+    guide: Vec<Guide>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -186,9 +186,9 @@ pub struct Plan {
     /// Quantities of interest.
     pub quantities: Vec<Quantity>,
     /// Reference points for the figures.
-    pub references: Vec<super::figures::Reference>,
+    pub references: Vec<Reference>,
     /// Power-law guide lines for the figures.
-    pub guides: Vec<super::figures::Guide>,
+    pub guides: Vec<Guide>,
     /// Case `i`'s parameter values, in the order of `params`.
     pub cases: Vec<Vec<f64>>,
     /// SHA-256 of the deck's text (hex; empty when unreadable): a finished case run
@@ -415,7 +415,9 @@ fn variation(p: &ParamFile) -> Result<Variation, String> {
 
 mod cases;
 mod draws;
+mod overlays;
 #[cfg(test)]
 mod tests;
 
 pub use draws::inverse_normal_cdf;
+pub use overlays::{Guide, Reference};
