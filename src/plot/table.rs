@@ -2,6 +2,7 @@
 //! unit of a column.
 
 use super::*;
+use crate::output::read::{ReadOptions, read_numeric};
 
 /// A CSV table of numbers with named columns.
 #[derive(Debug, Clone)]
@@ -21,23 +22,18 @@ impl Table {
             file: file.to_path_buf(),
             msg,
         };
-        let mut rdr = csv::Reader::from_path(file).map_err(|e| err(e.to_string()))?;
-        let columns: Vec<String> = rdr
-            .headers()
-            .map_err(|e| err(e.to_string()))?
-            .iter()
-            .map(|s| s.trim().to_string())
-            .collect();
-        let mut rows = Vec::new();
-        for (i, rec) in rdr.records().enumerate() {
-            let rec = rec.map_err(|e| err(e.to_string()))?;
-            let row: Result<Vec<f64>, _> = rec.iter().map(|v| v.trim().parse::<f64>()).collect();
-            rows.push(row.map_err(|e| err(format!("row {}: {e}", i + 2)))?);
-        }
+        let csv = read_numeric(
+            file,
+            ReadOptions {
+                trim: true,
+                first_column: None,
+            },
+        )
+        .map_err(err)?;
         Ok(Table {
             file: file.to_path_buf(),
-            columns,
-            rows,
+            columns: csv.header,
+            rows: csv.rows,
         })
     }
 
