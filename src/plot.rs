@@ -26,7 +26,6 @@ use plotters::prelude::*;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
 #[macro_use]
 mod draw;
@@ -36,7 +35,6 @@ mod table;
 mod trajectory;
 
 pub use animate::{animate, connectivity, deck_of, refine_of};
-pub(crate) use draw::ensure_font;
 pub use history::history;
 pub use table::{Table, quantity, read_node};
 pub use trajectory::trajectory;

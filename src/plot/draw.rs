@@ -14,22 +14,7 @@ pub(super) const COLORS: [RGBColor; 8] = [
     RGBColor(23, 190, 207),
 ];
 
-pub(super) static FONT: Once = Once::new();
-
-/// Registers the bundled font as plotters' "sans-serif" (once per process).
-pub(crate) fn ensure_font() {
-    FONT.call_once(|| {
-        let bytes: &'static [u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-        // The font is compiled in and known to parse; a failure would only lose the text.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, bytes);
-    });
-}
-
-#[derive(Clone, Copy, PartialEq)]
-pub(super) enum Format {
-    Svg,
-    Png,
-}
+pub(crate) use crate::figure::{Format, ensure_font};
 
 pub(super) fn format_of(out: &Path, allowed: &[&str]) -> Result<Format, PlotError> {
     let ext = out
@@ -64,27 +49,15 @@ pub(super) fn prepare_out(out: &Path) -> Result<(), PlotError> {
     Ok(())
 }
 
-/// Draws on an SVG or PNG backend chosen by the file's extension.
+/// Draws on an SVG or PNG backend chosen by the file's extension ([`crate::figure`]).
 macro_rules! with_backend {
     ($fmt:expr, $out:expr, $size:expr, |$root:ident| $body:expr) => {{
-        let draw_err = |msg: String| PlotError::Draw {
-            file: $out.to_path_buf(),
-            msg,
-        };
-        match $fmt {
-            Format::Svg => {
-                let $root = SVGBackend::new($out, $size).into_drawing_area();
-                $root.fill(&WHITE).map_err(|e| draw_err(e.to_string()))?;
-                $body.map_err(draw_err)?;
-                $root.present().map_err(|e| draw_err(e.to_string()))?;
+        crate::figure::draw_to!($fmt, $out, $size, |$root| $body).map_err(|msg| {
+            PlotError::Draw {
+                file: $out.to_path_buf(),
+                msg,
             }
-            Format::Png => {
-                let $root = BitMapBackend::new($out, $size).into_drawing_area();
-                $root.fill(&WHITE).map_err(|e| draw_err(e.to_string()))?;
-                $body.map_err(draw_err)?;
-                $root.present().map_err(|e| draw_err(e.to_string()))?;
-            }
-        }
+        })?;
     }};
 }
 
