@@ -84,7 +84,7 @@ fn collect_10000(c: &mut Criterion) {
     let mut g = c.benchmark_group("sweep");
     g.sample_size(10);
     g.bench_function("collect_10000", |b| {
-        b.iter(|| mecano::sweep::collect::collect(&plan).expect("collect"))
+        b.iter(|| mecano::sweep::collect_and_draw(&plan).expect("collect"))
     });
     g.finish();
     let _ = std::fs::remove_dir_all(Path::new(&out));

@@ -19,6 +19,7 @@
 //! error. `summary.json` reports its largest positive value relative to
 //! `max(|E(0)|, W_ext, the largest of T, U over the run)`.
 
+pub mod read;
 mod stream;
 pub mod vtk;
 

@@ -1,12 +1,12 @@
 //! Sparse iteration matrix and its LU factorisation with faer.
 //!
 //! The sparsity pattern is computed once from the element connectivity; the symbolic LU
-//! (fill-reducing COLAMD ordering, simplicial by default, see [`LuStrategy`]) is computed once per
+//! (fill-reducing COLAMD ordering, simplicial: see [`SparseSystem::new`]) is computed once per
 //! pattern and reused by every numeric factorisation; the numeric factors, the work space
 //! and the right-hand side live in buffers sized once, so a Newton iteration allocates
 //! nothing once the first factorisation has sized them.
 //!
-//! With the simplicial LU, faer's factorisation with partial pivoting (Gilbert & Peierls
+//! faer's simplicial factorisation with partial pivoting (Gilbert & Peierls
 //! 1988) is run once and then only when a pivot no longer passes: the next matrices are
 //! *refactored* with the same row pivots and the same pattern of `L` and `U` (the
 //! refactorisation of KLU: Davis & Palamadai Natarajan, ACM TOMS 37(3), 2010, §3), with the
@@ -20,9 +20,8 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::simplicial::{
     SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
 };
-use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::linalg::lu::{LuSymbolicParams, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par};
 
 mod factors;
 mod state;
@@ -43,21 +42,6 @@ pub enum LinearError {
     State(String),
 }
 
-/// Which sparse LU faer runs.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum LuStrategy {
-    /// faer's choice from the estimated flops per nonzero.
-    #[default]
-    Auto,
-    /// Left-looking simplicial LU (Gilbert–Peierls).
-    Simplicial,
-    /// Supernodal LU (dense blocks): on the pendulum's matrices (141 to 981 equations) its
-    /// numeric factorisation took 25–35 % less time than the simplicial one with pivot
-    /// searches, but it allocates at every call and is not refactored on kept pivots (the
-    /// simplicial refactorisation is ~3× cheaper than a pivoting simplicial factorisation).
-    Supernodal,
-}
-
 /// Threshold `u` of the pivot test of a refactorisation: a kept pivot must be at least `u`
 /// times the largest entry of its column of `L·u_jj` (1 = partial pivoting; 0.1 is the
 /// usual choice for sparse LU: Duff, Erisman & Reid, §5.4; growth stays within (1 + 1/u)
@@ -76,12 +60,10 @@ pub struct SparseSystem {
     /// Values, in pattern order.
     pub values: Vec<f64>,
     symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
     factor_mem: MemBuffer,
-    solve_mem: MemBuffer,
     factored: bool,
-    /// Simplicial path: faer's pivoting factors, their row permutation, and ours.
-    simplicial: Option<Box<Pivoting>>,
+    /// faer's pivoting factors and their row permutation (ours are in `factors`).
+    simplicial: Box<Pivoting>,
     factors: Factors,
     /// Factorisations with pivoting (the others were refactorisations).
     pivoting_factorizations: u64,
@@ -92,17 +74,12 @@ impl SparseSystem {
     /// symbolic factorisation, simplicial: it allocates nothing once its factors have
     /// grown to their fill, whereas faer 0.24's supernodal LU allocates its contribution
     /// blocks at every factorisation (~20 allocations per call on the pendulum), for a
-    /// factorisation 25–35 % faster but a whole run only ~5 % faster (see [`LuStrategy`]);
-    /// and only the simplicial factors are refactored on kept pivots (module docs).
+    /// factorisation 25–35 % faster but a whole run only ~5 % faster (measured on the
+    /// pendulum's matrices, 141 to 981 equations); and only the simplicial factors are
+    /// refactored on kept pivots (module docs), a refactorisation ~3× cheaper than a
+    /// pivoting factorisation. (faer's supernodal and automatic choices were selectable
+    /// until issue 27; no run used them.)
     pub fn new(columns: &[Vec<usize>]) -> Result<Self, LinearError> {
-        Self::with_strategy(columns, LuStrategy::Simplicial)
-    }
-
-    /// As [`SparseSystem::new`], with the choice of factorisation.
-    pub fn with_strategy(
-        columns: &[Vec<usize>],
-        strategy: LuStrategy,
-    ) -> Result<Self, LinearError> {
         let n = columns.len();
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
@@ -114,31 +91,15 @@ impl SparseSystem {
         let symbolic = {
             let pat = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
             let params = LuSymbolicParams {
-                supernodal_flop_ratio_threshold: match strategy {
-                    LuStrategy::Auto => SupernodalThreshold::AUTO,
-                    LuStrategy::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
-                    LuStrategy::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
-                },
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
                 ..Default::default()
             };
             factorize_symbolic_lu(pat, params)
                 .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?
         };
-        let simplicial = strategy == LuStrategy::Simplicial;
-        let factor_mem = MemBuffer::try_new(if simplicial {
-            factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n)
-        } else {
-            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
-        })
-        .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?;
-        // The simplicial path solves with its own factors: no faer scratch needed.
-        let solve_scratch = if simplicial {
-            faer::dyn_stack::StackReq::EMPTY
-        } else {
-            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)
-        };
-        let solve_mem = MemBuffer::try_new(solve_scratch)
-            .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?;
+        let factor_mem =
+            MemBuffer::try_new(factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n))
+                .map_err(|e| LinearError::Symbolic(format!("{e:?}")))?;
         let nnz = row_idx.len();
         Ok(SparseSystem {
             n,
@@ -146,11 +107,9 @@ impl SparseSystem {
             row_idx,
             values: vec![0.0; nnz],
             symbolic,
-            numeric: NumericLu::new(),
             factor_mem,
-            solve_mem,
             factored: false,
-            simplicial: simplicial.then(|| Box::new((SimplicialLu::new(), vec![0; n], vec![0; n]))),
+            simplicial: Box::new((SimplicialLu::new(), vec![0; n], vec![0; n])),
             factors: Factors::default(),
             pivoting_factorizations: 0,
         })
@@ -194,15 +153,11 @@ impl SparseSystem {
         self.values.iter_mut().for_each(|v| *v = 0.0);
     }
 
-    /// Numeric LU of the current values, reusing the symbolic factorisation; with the
-    /// simplicial LU, a refactorisation on the last pivots when they all pass the
+    /// Numeric LU of the current values, reusing the symbolic factorisation: a refactorisation on the last pivots when they all pass the
     /// threshold test, else a factorisation with partial pivoting.
     pub fn factor(&mut self) -> Result<(), LinearError> {
         self.factored = false;
-        if self.simplicial.is_some()
-            && self.factors.valid
-            && self.factors.refactor(&self.col_ptr, &self.values)
-        {
+        if self.factors.valid && self.factors.refactor(&self.col_ptr, &self.values) {
             self.factored = true;
             return Ok(());
         }
@@ -215,8 +170,8 @@ impl SparseSystem {
         );
         let mat = SparseColMatRef::new(pat, &self.values);
         self.pivoting_factorizations += 1;
-        if let Some(b) = self.simplicial.as_mut() {
-            let (lu, row_fwd, row_inv) = &mut **b;
+        {
+            let (lu, row_fwd, row_inv) = &mut *self.simplicial;
             factorize_simplicial_numeric_lu(
                 row_fwd,
                 row_inv,
@@ -240,23 +195,12 @@ impl SparseSystem {
                     self.n
                 )));
             }
-        } else {
-            self.symbolic
-                .factorize_numeric_lu(
-                    &mut self.numeric,
-                    mat,
-                    Par::Seq,
-                    MemStack::new(&mut self.factor_mem),
-                    Default::default(),
-                )
-                .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
         }
         self.factored = true;
         Ok(())
     }
 
-    /// Numeric factorisations that searched for pivots (with the simplicial LU, the
-    /// others were refactorisations on kept pivots).
+    /// Numeric factorisations that searched for pivots (the others were refactorisations on kept pivots).
     pub fn pivoting_factorizations(&self) -> u64 {
         self.pivoting_factorizations
     }
@@ -266,13 +210,7 @@ impl SparseSystem {
         if !self.factored {
             return Err(LinearError::Singular("not factored".into()));
         }
-        if self.simplicial.is_some() {
-            self.factors.solve(rhs);
-            return Ok(());
-        }
-        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.symbolic, &self.numeric);
-        let m = MatMut::from_column_major_slice_mut(rhs, self.n, 1);
-        lu.solve_in_place_with_conj(Conj::No, m, Par::Seq, MemStack::new(&mut self.solve_mem));
+        self.factors.solve(rhs);
         Ok(())
     }
 
@@ -315,16 +253,6 @@ mod tests {
         s.solve(&mut b).unwrap();
         for i in 0..3 {
             assert!((b[i] - x[i]).abs() < 1e-14);
-        }
-        // The other factorisations give the same solution.
-        for st in [LuStrategy::Auto, LuStrategy::Simplicial] {
-            let mut t = SparseSystem::with_strategy(&s.columns(), st).unwrap();
-            t.values.copy_from_slice(&s.values);
-            t.factor().unwrap();
-            let mut c = vec![0.0; 3];
-            t.mul(&x, &mut c);
-            t.solve(&mut c).unwrap();
-            assert!(c.iter().zip(&x).all(|(a, b)| (a - b).abs() < 1e-14));
         }
         // New values, same pattern.
         s.values.iter_mut().for_each(|v| *v *= 2.0);
@@ -474,7 +402,7 @@ mod tests {
             }
             cols[c] = rows;
         }
-        let mut s = SparseSystem::with_strategy(&cols, LuStrategy::Simplicial).unwrap();
+        let mut s = SparseSystem::new(&cols).unwrap();
         for &(r, c, v) in &entries {
             let p = s.position(r, c).unwrap();
             s.values[p] = v;
@@ -502,7 +430,7 @@ mod tests {
         s.factor().unwrap();
         let refactored_by_runs = solve(&mut s);
         // The same two factorisations and solves entry by entry.
-        let mut t = SparseSystem::with_strategy(&cols, LuStrategy::Simplicial).unwrap();
+        let mut t = SparseSystem::new(&cols).unwrap();
         for &(r, c, v) in &entries {
             let p = t.position(r, c).unwrap();
             t.values[p] = v;

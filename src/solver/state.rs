@@ -107,9 +107,6 @@ pub struct IntegratorState {
 /// Why a saved state cannot be restored into an integrator.
 #[derive(Debug, thiserror::Error)]
 pub enum StateError {
-    /// The supernodal LU keeps its factors in faer's storage: no checkpoint.
-    #[error("this run's linear solver cannot be checkpointed (supernodal LU)")]
-    Unsupported,
     /// The state was saved from a model of another size.
     #[error("the saved state has {what} {saved}, the model {model}")]
     Size {
@@ -155,11 +152,7 @@ impl Integrator {
             u: pairs(&self.u),
             tmap: self.tmap.iter().map(arr9).collect(),
             rhs: self.sys.rhs.clone(),
-            lu: self
-                .sys
-                .matrix
-                .save_state()
-                .ok_or(StateError::Unsupported)?,
+            lu: self.sys.matrix.save_state(),
             elements: self.sys.elements.iter().map(|e| e.save_state()).collect(),
         })
     }

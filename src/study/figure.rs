@@ -6,8 +6,6 @@ use std::path::Path;
 /// Draws the work–precision diagram: position error over the converged windows against CPU
 /// seconds, log–log; fixed-step runs joined by a line per α, adaptive runs as another series.
 pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
-    use plotters::prelude::*;
-    crate::plot::ensure_font();
     // Position error, or the rotation error when the chosen nodes do not translate.
     let c = compared_quantity(&r.runs);
     let pts: Vec<(f64, f64)> = r
@@ -33,32 +31,19 @@ pub fn draw_work_precision(r: &StudyReport, file: &Path) -> Result<(), String> {
     if let Some(dir) = file.parent() {
         std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
     }
-    match file.extension().and_then(|e| e.to_str()) {
-        Some("svg") => draw_wp(
-            SVGBackend::new(file, (800, 600)).into_drawing_area(),
-            r,
-            ranges,
-            c,
-        ),
-        _ => draw_wp(
-            BitMapBackend::new(file, (800, 600)).into_drawing_area(),
-            r,
-            ranges,
-            c,
-        ),
-    }
+    let format = crate::figure::Format::of(file);
+    crate::figure::draw_to!(format, file, (800, 600), |root| draw_wp(root, r, ranges, c))
 }
 
 fn draw_wp<DB: plotters::prelude::DrawingBackend>(
-    root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
     r: &StudyReport,
     (x0, x1, y0, y1): (f64, f64, f64, f64),
     c: usize,
 ) -> Result<(), String> {
     use plotters::prelude::*;
     {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(root)
             .caption("Work-precision (converged windows)", ("sans-serif", 22))
             .margin(15)
             .x_label_area_size(45)
@@ -133,7 +118,7 @@ fn draw_wp<DB: plotters::prelude::DrawingBackend>(
             .border_style(BLACK)
             .draw()
             .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())
+        Ok(())
     }
 }
 

@@ -161,7 +161,8 @@ pub fn statistics_csv(plan: &Plan, records: &[CaseRecord]) -> String {
     s
 }
 
-/// Reads every case directory and writes sweep.csv, statistics.csv and the figures.
+/// Reads every case directory and writes sweep.csv and statistics.csv (the figures are
+/// drawn from its records by `figures::draw`; `collect_and_draw` in the sweep module does both).
 pub fn collect(plan: &Plan) -> Result<Collected, SweepError> {
     let records = records(plan);
     let io = |p: &PathBuf, e: std::io::Error| SweepError::Io {
@@ -178,7 +179,6 @@ pub fn collect(plan: &Plan) -> Result<Collected, SweepError> {
         std::fs::write(&p, text).map_err(|e| io(&p, e))?;
         files.push(p);
     }
-    files.extend(super::figures::draw(plan, &records)?);
     Ok(Collected { records, files })
 }
 

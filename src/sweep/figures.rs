@@ -13,41 +13,11 @@
 //! value, their ticks labelled with the value.
 
 use super::SweepError;
+use super::collect::values_of;
 use super::plan::{Plan, Variation};
 use super::runner::{CaseRecord, Status};
 use plotters::prelude::*;
-use serde::Deserialize;
 use std::path::PathBuf;
-
-/// Published or reference points drawn on a 1-D sweep's figure.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Reference {
-    /// The quantity (y).
-    pub quantity: String,
-    /// The parameter (x).
-    pub parameter: String,
-    /// Legend.
-    pub label: String,
-    /// (x, y) pairs.
-    pub points: Vec<[f64; 2]>,
-}
-
-/// A power-law guide y = y0 (x / x0)^exponent.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Guide {
-    /// The quantity (y).
-    pub quantity: String,
-    /// The parameter (x).
-    pub parameter: String,
-    /// Legend.
-    pub label: String,
-    /// The exponent.
-    pub exponent: f64,
-    /// The point (x0, y0) it passes through.
-    pub through: [f64; 2],
-}
 
 struct Axis {
     log: bool,
@@ -122,35 +92,26 @@ fn draw_xy(
     axes: (&Axis, &Axis),
     series: &[Series],
 ) -> Result<(), String> {
-    crate::plot::ensure_font();
-    xy_on(
-        SVGBackend::new(file, SIZE).into_drawing_area(),
-        title,
-        names,
-        axes,
-        series,
-    )?;
+    use crate::figure::{Format, draw_to};
+    draw_to!(Format::Svg, file, SIZE, |root| xy_on(
+        root, title, names, axes, series
+    ))?;
     let png = file.with_extension("png");
-    xy_on(
-        BitMapBackend::new(&png, SIZE).into_drawing_area(),
-        title,
-        names,
-        axes,
-        series,
-    )
+    draw_to!(Format::Png, &png, SIZE, |root| xy_on(
+        root, title, names, axes, series
+    ))
 }
 
 const SIZE: (u32, u32) = (800, 520);
 
 fn xy_on<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
+    root: &DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
     (xname, yname): (&str, &str),
     (xa, ya): (&Axis, &Axis),
     series: &[Series],
 ) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(45)
@@ -190,29 +151,23 @@ fn xy_on<DB: DrawingBackend>(
         .border_style(BLACK)
         .draw()
         .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+    Ok(())
 }
 
 /// Draws into `file` (`.svg`) and its `.png` twin.
 fn draw_hist(file: &PathBuf, title: &str, name: &str, x: &[f64]) -> Result<(), String> {
-    crate::plot::ensure_font();
-    hist_on(
-        SVGBackend::new(file, SIZE).into_drawing_area(),
-        title,
-        name,
-        x,
-    )?;
+    use crate::figure::{Format, draw_to};
+    draw_to!(Format::Svg, file, SIZE, |root| hist_on(
+        root, title, name, x
+    ))?;
     let png = file.with_extension("png");
-    hist_on(
-        BitMapBackend::new(&png, SIZE).into_drawing_area(),
-        title,
-        name,
-        x,
-    )
+    draw_to!(Format::Png, &png, SIZE, |root| hist_on(
+        root, title, name, x
+    ))
 }
 
 fn hist_on<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
+    root: &DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
     name: &str,
     x: &[f64],
@@ -236,8 +191,7 @@ fn hist_on<DB: DrawingBackend>(
         counts[k] += 1;
     }
     let top = f64::from(counts.iter().copied().max().unwrap_or(1)) * 1.1;
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(45)
@@ -258,7 +212,7 @@ fn hist_on<DB: DrawingBackend>(
             Rectangle::new([(x0, 0.0), (x0 + w, f64::from(*c))], BLUE.mix(0.5).filled())
         }))
         .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+    Ok(())
 }
 
 /// Draws the figures of the plan's kind; returns the files written.
@@ -368,7 +322,7 @@ pub fn draw(plan: &Plan, records: &[CaseRecord]) -> Result<Vec<PathBuf>, SweepEr
         .collect();
     if !random.is_empty() {
         for (k, q) in plan.quantities.iter().enumerate() {
-            let x = super::collect::values_of(records, k);
+            let x = values_of(records, k);
             if x.is_empty() {
                 continue;
             }

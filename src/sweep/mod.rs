@@ -24,6 +24,14 @@ use plan::Plan;
 use std::io::Write;
 use std::path::PathBuf;
 
+/// Collects a sweep (sweep.csv, statistics.csv) and draws its figures: the data flows
+/// plan → runner → collect → figures, and only this top level calls the last two.
+pub fn collect_and_draw(plan: &Plan) -> Result<collect::Collected, SweepError> {
+    let mut c = collect::collect(plan)?;
+    c.files.extend(figures::draw(plan, &c.records)?);
+    Ok(c)
+}
+
 /// What can go wrong in a sweep (the cases' own failures are recorded, not errors).
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
@@ -241,7 +249,7 @@ pub fn run(args: &SweepArgs) -> u8 {
             return EXIT_OK;
         }
     }
-    match collect::collect(&plan) {
+    match collect_and_draw(&plan) {
         Ok(c) => {
             let count = |s: runner::Status| c.records.iter().filter(|r| r.status == s).count();
             let missing = count(runner::Status::Missing);

@@ -70,9 +70,9 @@ struct PlanFile {
     #[serde(default)]
     quantity: Vec<QuantitySpec>,
     #[serde(default)]
-    reference: Vec<super::figures::Reference>,
+    reference: Vec<Reference>,
     #[serde(default)]
-    guide: Vec<super::figures::Guide>,
+    guide: Vec<Guide>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -186,9 +186,9 @@ pub struct Plan {
     /// Quantities of interest.
     pub quantities: Vec<Quantity>,
     /// Reference points for the figures.
-    pub references: Vec<super::figures::Reference>,
+    pub references: Vec<Reference>,
     /// Power-law guide lines for the figures.
-    pub guides: Vec<super::figures::Guide>,
+    pub guides: Vec<Guide>,
     /// Case `i`'s parameter values, in the order of `params`.
     pub cases: Vec<Vec<f64>>,
     /// SHA-256 of the deck's text (hex; empty when unreadable): a finished case run
@@ -318,144 +318,6 @@ impl Plan {
         plan.cases = plan.generate().map_err(|m| bad(path, m))?;
         Ok(plan)
     }
-
-    /// The grid points (factorial or zipped) of the non-random parameters: for each, the
-    /// values of the grid parameters in plan order.
-    fn grid(&self) -> Result<Vec<Vec<f64>>, String> {
-        let lists: Vec<&Vec<f64>> = self
-            .params
-            .iter()
-            .filter_map(|p| match &p.variation {
-                Variation::Grid { values, .. } => Some(values),
-                _ => None,
-            })
-            .collect();
-        if lists.is_empty() {
-            return Ok(vec![vec![]]);
-        }
-        if self.zip {
-            let n = lists[0].len();
-            if lists.iter().any(|l| l.len() != n) {
-                let lens: Vec<String> = lists.iter().map(|l| l.len().to_string()).collect();
-                return Err(format!(
-                    "combine = \"zip\" needs lists of one length, found {}",
-                    lens.join(", ")
-                ));
-            }
-            return Ok((0..n)
-                .map(|i| lists.iter().map(|l| l[i]).collect())
-                .collect());
-        }
-        let total = lists
-            .iter()
-            .try_fold(1usize, |acc, l| {
-                acc.checked_mul(l.len()).filter(|&t| t <= MAX_CASES)
-            })
-            .ok_or(format!(
-                "the factorial product has more than {MAX_CASES} cases"
-            ))?;
-        let mut out = Vec::with_capacity(total);
-        for mut i in 0..total {
-            let mut row = vec![0.0; lists.len()];
-            for (k, l) in lists.iter().enumerate().rev() {
-                row[k] = l[i % l.len()];
-                i /= l.len();
-            }
-            out.push(row);
-        }
-        Ok(out)
-    }
-
-    /// The random samples: for each, the values of the random parameters in plan order.
-    fn random(&self) -> Vec<Vec<f64>> {
-        let dists: Vec<&Variation> = self
-            .params
-            .iter()
-            .map(|p| &p.variation)
-            .filter(|v| v.is_random())
-            .collect();
-        if dists.is_empty() {
-            return vec![vec![]];
-        }
-        let n = self.samples;
-        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
-        let mut out = vec![vec![0.0; dists.len()]; n];
-        match self.sampling {
-            Sampling::MonteCarlo => {
-                for row in out.iter_mut() {
-                    for (j, d) in dists.iter().enumerate() {
-                        row[j] = d.at(open_unit(&mut rng));
-                    }
-                }
-            }
-            Sampling::LatinHypercube => {
-                for (j, d) in dists.iter().enumerate() {
-                    let mut perm: Vec<usize> = (0..n).collect();
-                    for i in (1..n).rev() {
-                        let k = (rng.next_u64() % (i as u64 + 1)) as usize;
-                        perm.swap(i, k);
-                    }
-                    for (i, row) in out.iter_mut().enumerate() {
-                        let u = (perm[i] as f64 + open_unit(&mut rng)) / n as f64;
-                        row[j] = d.at(u);
-                    }
-                }
-            }
-        }
-        out
-    }
-
-    fn generate(&self) -> Result<Vec<Vec<f64>>, String> {
-        let grid = self.grid()?;
-        if grid.len().saturating_mul(self.samples) > MAX_CASES {
-            return Err(format!("more than {MAX_CASES} cases"));
-        }
-        let random = self.random();
-        let mut cases = Vec::with_capacity(grid.len() * random.len());
-        for g in &grid {
-            for r in &random {
-                let (mut gi, mut ri) = (g.iter(), r.iter());
-                let row: Vec<f64> = self
-                    .params
-                    .iter()
-                    .map(|p| {
-                        let v = if p.variation.is_random() {
-                            ri.next()
-                        } else {
-                            gi.next()
-                        };
-                        v.copied().unwrap_or(f64::NAN)
-                    })
-                    .collect();
-                cases.push(row);
-            }
-        }
-        Ok(cases)
-    }
-
-    /// Case `i`'s overrides: (parameter name, value).
-    pub fn overrides(&self, i: usize) -> Vec<(String, f64)> {
-        self.params
-            .iter()
-            .zip(&self.cases[i])
-            .map(|(p, v)| (p.name.clone(), *v))
-            .collect()
-    }
-
-    /// The directory of case `i`: `<out>/cases/<i, zero-padded>`.
-    pub fn case_dir(&self, i: usize) -> PathBuf {
-        let width = self.cases.len().saturating_sub(1).to_string().len().max(4);
-        self.out.join("cases").join(format!("{i:0width$}"))
-    }
-
-    /// Whether exactly one parameter varies, on a grid (a 1-D sweep: curves of the
-    /// quantities against it).
-    pub fn one_dimensional(&self) -> Option<usize> {
-        let grid: Vec<usize> = (0..self.params.len())
-            .filter(|&k| matches!(&self.params[k].variation, Variation::Grid { values, .. } if values.len() > 1))
-            .collect();
-        (grid.len() == 1 && !self.params.iter().any(|p| p.variation.is_random())).then(|| grid[0])
-    }
 }
 
 fn variation(p: &ParamFile) -> Result<Variation, String> {
@@ -551,152 +413,11 @@ fn variation(p: &ParamFile) -> Result<Variation, String> {
     }
 }
 
-/// A uniform draw in the open interval (0, 1): 53 random bits, offset by half a unit.
-fn open_unit(rng: &mut ChaCha8Rng) -> f64 {
-    ((rng.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-}
-
-/// Φ⁻¹(p), the standard normal quantile, by Acklam's rational approximation (relative
-/// error below 1.15e-9 on (0, 1)).
-pub fn inverse_normal_cdf(p: f64) -> f64 {
-    const A: [f64; 6] = [
-        -3.969683028665376e1,
-        2.209460984245205e2,
-        -2.759285104469687e2,
-        1.383_577_518_672_69e2,
-        -3.066479806614716e1,
-        2.506628277459239,
-    ];
-    const B: [f64; 5] = [
-        -5.447609879822406e1,
-        1.615858368580409e2,
-        -1.556989798598866e2,
-        6.680131188771972e1,
-        -1.328068155288572e1,
-    ];
-    const C: [f64; 6] = [
-        -7.784894002430293e-3,
-        -3.223964580411365e-1,
-        -2.400758277161838,
-        -2.549732539343734,
-        4.374664141464968,
-        2.938163982698783,
-    ];
-    const D: [f64; 4] = [
-        7.784695709041462e-3,
-        3.224671290700398e-1,
-        2.445134137142996,
-        3.754408661907416,
-    ];
-    const LOW: f64 = 0.02425;
-    let tail = |q: f64| {
-        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
-            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
-    };
-    if p < LOW {
-        tail((-2.0 * p.ln()).sqrt())
-    } else if p > 1.0 - LOW {
-        -tail((-2.0 * (1.0 - p).ln()).sqrt())
-    } else {
-        let q = p - 0.5;
-        let r = q * q;
-        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
-            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
-    }
-}
-
+mod cases;
+mod draws;
+mod overlays;
 #[cfg(test)]
-mod tests {
-    use super::*;
+mod tests;
 
-    fn plan(text: &str) -> Result<Plan, SweepError> {
-        Plan::parse(text, Path::new("sweeps/p.toml"), None)
-    }
-
-    #[test]
-    fn inverse_normal_matches_known_quantiles() {
-        // Φ⁻¹ at 0.5, 0.975, 0.8413447460685429 (Φ(1)), 1e-6 (tables: −4.753424308822899).
-        assert_eq!(inverse_normal_cdf(0.5), 0.0);
-        assert!((inverse_normal_cdf(0.975) - 1.959963984540054).abs() < 1.15e-9 * 1.96);
-        assert!((inverse_normal_cdf(0.8413447460685429) - 1.0).abs() < 2e-9);
-        assert!((inverse_normal_cdf(1e-6) + 4.753424308822899).abs() < 1.15e-9 * 4.76);
-        assert!((inverse_normal_cdf(1.0 - 0.975) + 1.959963984540054).abs() < 3e-9);
-    }
-
-    #[test]
-    fn grids_factorial_zip_and_ranges() {
-        let p = plan("deck = \"d.dat\"\n[[parameter]]\nname = \"a\"\nvalues = [1, 2]\n[[parameter]]\nname = \"b\"\nfrom = 1\nto = 100\nn = 3\nscale = \"log\"\n").expect("valid");
-        assert_eq!(p.deck, PathBuf::from("sweeps/d.dat"));
-        assert_eq!(p.out, PathBuf::from("out/sweeps/p"));
-        assert_eq!(p.cases.len(), 6);
-        assert_eq!(p.cases[0], [1.0, 1.0]);
-        assert!((p.cases[1][1] - 10.0).abs() < 1e-12);
-        assert_eq!(p.cases[2], [1.0, 100.0]);
-        assert_eq!(p.cases[3], [2.0, 1.0]);
-        assert_eq!(p.case_dir(3), PathBuf::from("out/sweeps/p/cases/0003"));
-        let z = plan("deck = \"d.dat\"\ncombine = \"zip\"\n[[parameter]]\nname = \"a\"\nvalues = [1, 2]\n[[parameter]]\nname = \"b\"\nfrom = 0\nto = 1\nn = 2\n").expect("valid");
-        assert_eq!(z.cases, vec![vec![1.0, 0.0], vec![2.0, 1.0]]);
-        assert_eq!(z.one_dimensional(), None);
-        let bad = plan(
-            "deck = \"d.dat\"\ncombine = \"zip\"\n[[parameter]]\nname = \"a\"\nvalues = [1, 2]\n[[parameter]]\nname = \"b\"\nvalues = [1]\n",
-        );
-        assert!(bad.is_err());
-    }
-
-    #[test]
-    fn random_draws_are_reproducible_and_stratified() {
-        let text = "deck = \"d.dat\"\nsamples = 100\nseed = 7\nsampling = \"latin-hypercube\"\n\
-            [[parameter]]\nname = \"k\"\ndistribution = \"uniform\"\nlow = 0\nhigh = 1\n\
-            [[parameter]]\nname = \"E\"\ndistribution = \"lognormal\"\nmedian = 2\nsigma = 0.05\n";
-        let a = plan(text).expect("valid");
-        let b = plan(text).expect("valid");
-        assert_eq!(a.cases, b.cases, "same plan, same cases");
-        // Latin hypercube: exactly one k in each of the 100 strata [i/100, (i+1)/100).
-        let mut strata: Vec<usize> = a.cases.iter().map(|c| (c[0] * 100.0) as usize).collect();
-        strata.sort_unstable();
-        assert_eq!(strata, (0..100).collect::<Vec<_>>());
-        // ln E: one value per normal stratum, so its sample mean is ln 2 within a few
-        // 1e-4 (the stratified mean's error is far below the MC error sigma/10 = 5e-3).
-        let m = a.cases.iter().map(|c| c[1].ln()).sum::<f64>() / 100.0;
-        assert!((m - 2f64.ln()).abs() < 1e-3, "{m}");
-        let other = plan(&text.replace("seed = 7", "seed = 8")).expect("valid");
-        assert_ne!(a.cases, other.cases);
-        let mc = plan(&text.replace("latin-hypercube", "monte-carlo")).expect("valid");
-        assert!(
-            mc.cases
-                .iter()
-                .all(|c| (0.0..1.0).contains(&c[0]) && c[1] > 0.0)
-        );
-    }
-
-    #[test]
-    fn mistakes_are_reported() {
-        for (text, needle) in [
-            ("deck = \"d.dat\"\n", "no [[parameter]]"),
-            (
-                "deck = \"d.dat\"\n[[parameter]]\nname = \"a\"\n",
-                "exactly one",
-            ),
-            (
-                "deck = \"d.dat\"\n[[parameter]]\nname = \"a\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n",
-                "samples",
-            ),
-            (
-                "deck = \"d.dat\"\nsamples = 3\n[[parameter]]\nname = \"a\"\ndistribution = \"uniform\"\nlow = 1\nhigh = 2\n",
-                "seed",
-            ),
-            (
-                "deck = \"d.dat\"\n[[parameter]]\nname = \"a\"\nfrom = -1\nto = 2\nn = 3\nscale = \"log\"\n",
-                "logarithmic",
-            ),
-            ("deck = \"d.dat\"\nbogus = 1\n", "bogus"),
-            (
-                "deck = \"d.dat\"\n[[parameter]]\nname = \"a\"\nvalues = [1]\n[[parameter]]\nname = \"a\"\nvalues = [2]\n",
-                "twice",
-            ),
-        ] {
-            let e = plan(text).expect_err(text).to_string();
-            assert!(e.contains(needle), "{text}: {e}");
-        }
-    }
-}
+pub use draws::inverse_normal_cdf;
+pub use overlays::{Guide, Reference};

@@ -26,12 +26,10 @@ pub struct LuState {
 }
 
 impl SparseSystem {
-    /// The state a restart needs ([`LuState`]); `None` for the supernodal LU, whose
-    /// factors live in faer's own storage.
-    pub fn save_state(&self) -> Option<LuState> {
-        self.simplicial.as_ref()?;
+    /// The state a restart needs ([`LuState`]).
+    pub fn save_state(&self) -> LuState {
         let f = &self.factors;
-        Some(LuState {
+        LuState {
             values: self.values.clone(),
             factored: self.factored,
             valid: f.valid,
@@ -46,7 +44,7 @@ impl SparseSystem {
             col_fwd: f.col_fwd.clone(),
             a_row: f.a_row.clone(),
             pivoting_factorizations: self.pivoting_factorizations,
-        })
+        }
     }
 
     /// Restores a [`SparseSystem::save_state`] of a system with the same pattern. The
@@ -55,9 +53,6 @@ impl SparseSystem {
     pub fn restore_state(&mut self, s: LuState) -> Result<(), LinearError> {
         let n = self.n;
         let bad = |what: &str| Err(LinearError::State(what.to_string()));
-        if self.simplicial.is_none() {
-            return bad("only the simplicial LU can be restored");
-        }
         if s.values.len() != self.values.len() {
             return bad("the matrix has another number of entries");
         }

@@ -225,8 +225,6 @@ pub fn print_space_time(r: &SpaceTimeReport, out: &mut dyn Write) -> io::Result<
 /// Draws the work–precision diagram over both variables: each mesh's runs joined along the
 /// steps, the frontier as a black line (error over the windows scored; log–log).
 pub fn draw_space_time(r: &SpaceTimeReport, file: &Path) -> Result<(), String> {
-    use plotters::prelude::*;
-    crate::plot::ensure_font();
     let ok = |x: &&GridRun| x.error > 0.0 && x.error.is_finite() && x.stats.cpu_seconds > 0.0;
     let pts: Vec<(f64, f64)> = r
         .runs
@@ -244,29 +242,22 @@ pub fn draw_space_time(r: &SpaceTimeReport, file: &Path) -> Result<(), String> {
     if let Some(dir) = file.parent() {
         std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
     }
-    match file.extension().and_then(|e| e.to_str()) {
-        Some("svg") => draw_st(
-            SVGBackend::new(file, (900, 650)).into_drawing_area(),
-            r,
-            (x0, x1, y0, y1),
-        ),
-        _ => draw_st(
-            BitMapBackend::new(file, (900, 650)).into_drawing_area(),
-            r,
-            (x0, x1, y0, y1),
-        ),
-    }
+    let format = crate::figure::Format::of(file);
+    crate::figure::draw_to!(format, file, (900, 650), |root| draw_st(
+        root,
+        r,
+        (x0, x1, y0, y1)
+    ))
 }
 
 fn draw_st<DB: plotters::prelude::DrawingBackend>(
-    root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
     r: &SpaceTimeReport,
     (x0, x1, y0, y1): (f64, f64, f64, f64),
 ) -> Result<(), String> {
     use plotters::prelude::*;
     let ok = |x: &&GridRun| x.error > 0.0 && x.error.is_finite() && x.stats.cpu_seconds > 0.0;
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(root)
         .caption(
             "Work-precision over mesh and step (windows converged in space and time)",
             ("sans-serif", 18),
@@ -333,5 +324,5 @@ fn draw_st<DB: plotters::prelude::DrawingBackend>(
         .border_style(BLACK)
         .draw()
         .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+    Ok(())
 }

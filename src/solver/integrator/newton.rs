@@ -1,0 +1,294 @@
+//! The Newton loop of a step (modified or full Newton, polishing, constraint and residual
+//! tests) and the diagnosis of a failed step.
+
+use super::*;
+
+impl Integrator {
+    /// What the elements have to say about the last trial state (or, if an element is
+    /// silent on it, the last accepted one), e.g. a universal joint at 90°.
+    pub(super) fn diagnoses(&self) -> Box<[String]> {
+        self.sys
+            .elements
+            .iter()
+            .filter_map(|e| e.diagnose(&self.trial).or_else(|| e.diagnose(&self.nodes)))
+            .collect()
+    }
+
+    pub(super) fn failure(
+        &self,
+        h: f64,
+        reason: FailureReason,
+        history: Vec<f64>,
+        fref: f64,
+    ) -> Failure {
+        // Worst equation of the last assembled residual.
+        let (mut worst, mut wv) = (0, 0.0f64);
+        for (i, r) in self.sys.rhs.iter().enumerate() {
+            let v = if r.is_finite() {
+                r.abs()
+            } else {
+                f64::INFINITY
+            };
+            if v > wv {
+                wv = v;
+                worst = i;
+            }
+        }
+        Failure {
+            time: self.t,
+            step: h,
+            reason,
+            residual_history: history,
+            worst: if self.sys.n_eq() > 0 {
+                self.sys.describe(worst)
+            } else {
+                "-".into()
+            },
+            worst_value: wv,
+            reference_force: fref,
+            diagnoses: self.diagnoses(),
+        }
+    }
+
+    /// Attempts one step of size `h` from the current state (or one load increment to
+    /// load factor `t + h` in statics). On success the state advances; on failure it is
+    /// left unchanged and a diagnosis is returned.
+    pub fn try_step(&mut self, h: f64) -> Result<StepInfo, Failure> {
+        let t1 = self.t + h;
+        let p = self.hht;
+        // Rescale multipliers to this step's constraint scale.
+        let s_new = if self.dynamic {
+            self.scale_for(h)
+        } else {
+            self.scale
+        };
+        let ratio = self.scale / s_new;
+        let nn = self.sys.n_node_eq;
+        self.trial_lambda.copy_from_slice(&self.lambda);
+        for l in &mut self.trial_lambda[nn..] {
+            *l *= ratio;
+        }
+        // Predictor: constant true acceleration (dynamics) or no increment (statics).
+        for i in 0..self.nodes.len() {
+            let s = &self.nodes[i];
+            self.u[i] = if self.dynamic {
+                let [a0x, a0r] = self.pseudo[i];
+                [
+                    s.v * h + (a0x * (0.5 - p.beta) + s.a * p.beta) * (h * h),
+                    s.w * h + (a0r * (0.5 - p.beta) + s.wd * p.beta) * (h * h),
+                ]
+            } else {
+                [Vector3::zeros(); 2]
+            };
+        }
+        let ctx = self.context(t1, h, s_new);
+        let mut history = std::mem::take(&mut self.history);
+        history.clear();
+        // Constraint equations are met to an absolute tolerance (m or rad), with a round-off
+        // floor for very large models.
+        let tol_len = CONSTRAINT_TOL.max(100.0 * f64::EPSILON * self.sys.ref_length);
+        let mut last_inc = f64::INFINITY;
+        let mut prev_inc = f64::INFINITY;
+        let mut fref = self.sys.ref_force;
+        // Modified Newton: the iteration matrix factored for an earlier iterate (of this
+        // step, or of a previous step of the same size) is kept while the residual contracts
+        // by at least CONTRACTION per iteration; otherwise it is rebuilt at the current
+        // iterate. Iterations without a rebuild assemble the residual alone.
+        // (A step of the same size within round-off: fixed steps coming back to their grid after
+        // an event are differences of times.)
+        // (lu_step is NaN when no factorisation is valid: the test below is then false.)
+        let same_step = (self.lu_step - h).abs() <= 1e-9 * h;
+        let mut tangent = !self.newton.modified || !same_step;
+        let mut prev_rel = f64::INFINITY;
+        // Whether the last solve used a matrix built at the iterate it started from.
+        let mut fresh = false;
+        for iter in 0..=self.newton.max_iterations {
+            if let Some(a) = &self.abort
+                && a.load(std::sync::atomic::Ordering::Relaxed)
+            {
+                return Err(self.failure(h, FailureReason::Aborted, history, fref));
+            }
+            self.trial_from_u(h);
+            if tangent {
+                self.update_tangent_maps();
+            }
+            let info = self.sys.assemble_with(
+                &ctx,
+                &self.trial,
+                &self.trial_lambda,
+                tangent,
+                Some(&self.tmap),
+            );
+            fref = self.sys.ref_force.max(info.force_scale).max(1e-30);
+            let rn = self.sys.rhs[..nn]
+                .iter()
+                .fold(0.0f64, |m, v| nan_max(m, v.abs()));
+            // Constraint rows hold `s Φ`: a force, so they get the force tolerance too
+            // (else a violation of the absolute tolerance, amplified by 1/(βh²) through the
+            // inertia terms, shows up in the multipliers: Cardona & Géradin 1989).
+            let cf = self.sys.rhs[nn..]
+                .iter()
+                .fold(0.0f64, |m, v| nan_max(m, v.abs()));
+            let cn = cf / s_new;
+            // Round-off of the inertia terms: positions known to ε L_ref, angles to ε rad
+            // (a body spinning exactly about a principal axis has nothing else to scale by).
+            let floor = self.residual_floor
+                + 10.0
+                    * f64::EPSILON
+                    * ctx.c_a
+                    * (self.sys.ref_length * self.mass_ref + self.rot_mass_ref);
+            let fscale = fref.max(floor / self.newton.tol_residual);
+            let rel = rn.max(cf) / fscale;
+            history.push(rel);
+            if !rel.is_finite() || !cn.is_finite() {
+                return Err(self.failure(h, FailureReason::NotFinite, history, fref));
+            }
+            // After a solve with a kept matrix the iterate's error is ~ρ/(1−ρ) of the last
+            // increment, not ~its square as after a Newton step: iterate on while the
+            // residual still falls (each such iteration is one residual and one solve), so
+            // the result is as accurate as full Newton's (the rigid pendulum drifts by
+            // 4e-5 m in 0.3 s otherwise: residuals at the round-off floor of stiff bars hide
+            // 1e-10 m errors in the mechanism's directions, which add up step after step).
+            // Where the residual stagnates above that (the round-off floor of stiff models)
+            // it no longer shows the error: with E = 2.1e15 bars an iterate accepted there
+            // drifted 5.2e-8 m in 0.3 s from full Newton (an error in u becomes a velocity
+            // error γ/(βh) times larger). There the increments must have fallen to 1/1000 of
+            // the increment tolerance too, or have stopped falling (round-off): 2.3e-9 m
+            // (`tests/accuracy.rs`), for no more iterations elsewhere.
+            let increments_done =
+                last_inc <= 1e-3 * self.newton.tol_increment || last_inc > 0.5 * prev_inc;
+            let polished = iter == 0
+                || fresh
+                || rel <= 0.01 * self.newton.tol_residual
+                || (rel > 0.5 * prev_rel && increments_done);
+            let converged = rel <= self.newton.tol_residual
+                && cn <= tol_len
+                && (iter == 0 || last_inc <= self.newton.tol_increment)
+                && polished;
+            if converged {
+                if self.dynamic
+                    && let Some(a) = self.adaptive.clone()
+                {
+                    // Local error control before committing (Zienkiewicz & Xie 1991).
+                    let err = self.local_error(h, &a);
+                    let factor = 0.9 * err.max(1e-12).powf(-1.0 / 3.0);
+                    if err > 1.0 && h > self.event_floor * (1.0 + 1e-9) {
+                        let retry = (h * factor.max(0.2)).max(self.event_floor);
+                        return Err(self.failure(
+                            h,
+                            FailureReason::StepRefused(retry),
+                            history,
+                            fref,
+                        ));
+                    }
+                    self.error_next = h * factor.min(a.max_growth);
+                }
+                if self.dynamic {
+                    // Event control before committing: an element may refuse the step.
+                    let (old, new) = (&self.nodes, &self.trial);
+                    let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
+                    for lim in self
+                        .sys
+                        .elements
+                        .iter()
+                        .filter_map(|e| e.step_limit(&ctx, old, new))
+                    {
+                        next = next.min(lim.next);
+                        if h > lim.accept_up_to {
+                            refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
+                        }
+                    }
+                    if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
+                        let retry = retry.max(self.event_floor).min(0.999 * h);
+                        return Err(self.failure(
+                            h,
+                            FailureReason::StepRefused(retry),
+                            history,
+                            fref,
+                        ));
+                    }
+                    self.step_cap = next;
+                }
+                self.accept(h, &ctx);
+                self.history = history;
+                self.stats.newton_iterations += iter as u64;
+                return Ok(StepInfo {
+                    iterations: iter,
+                    residual: rel,
+                });
+            }
+            if iter == self.newton.max_iterations {
+                break;
+            }
+            // A kept matrix must contract the residual by CONTRACTION per iteration, and
+            // past half of the iterations allowed it is rebuilt anyway: a linear rate that
+            // passes the test could still spend them all on polishing, where a fresh Newton
+            // step converges quadratically.
+            let slow = iter > 0
+                && (rel > CONTRACTION * prev_rel || 2 * iter >= self.newton.max_iterations);
+            if !tangent && slow {
+                // The kept matrix no longer contracts well: rebuild it here (the residual
+                // is assembled again with it; `rel` above was finite, or we returned).
+                tangent = true;
+                self.update_tangent_maps();
+                self.sys.assemble_with(
+                    &ctx,
+                    &self.trial,
+                    &self.trial_lambda,
+                    true,
+                    Some(&self.tmap),
+                );
+            }
+            prev_rel = rel;
+            fresh = tangent;
+            if tangent {
+                self.lu_step = f64::NAN;
+                if let Err(e) = self.sys.matrix.factor() {
+                    self.stats.factorizations += 1;
+                    let why =
+                        match crate::solver::redundancy::redundancy_error(&self.sys, &self.trial) {
+                            Some(r) => format!("{e}; {r}"),
+                            None => e.to_string(),
+                        };
+                    return Err(self.failure(h, FailureReason::Singular(why), history, fref));
+                }
+                self.stats.factorizations += 1;
+                self.lu_step = h;
+                tangent = !self.newton.modified;
+            }
+            self.delta.copy_from_slice(&self.sys.rhs);
+            if let Err(e) = self.sys.matrix.solve(&mut self.delta) {
+                return Err(self.failure(h, FailureReason::Singular(e.to_string()), history, fref));
+            }
+            let (mut inc_x, mut inc_r) = (0.0f64, 0.0f64);
+            for (i, d) in self.sys.node_dofs.iter().enumerate() {
+                for c in 0..6 {
+                    if d[c] != crate::solver::system::FIXED {
+                        let v = -self.delta[d[c]];
+                        if c < 3 {
+                            self.u[i][0][c] += v;
+                            inc_x = nan_max(inc_x, v.abs());
+                        } else {
+                            self.u[i][1][c - 3] += v;
+                            inc_r = nan_max(inc_r, v.abs());
+                        }
+                    }
+                }
+            }
+            for k in nn..self.sys.n_eq() {
+                self.trial_lambda[k] -= self.delta[k];
+            }
+            prev_inc = last_inc;
+            last_inc = (inc_x / self.sys.ref_length).max(inc_r);
+            if !last_inc.is_finite() {
+                return Err(self.failure(h, FailureReason::NotFinite, history, fref));
+            }
+        }
+        Err(self.failure(
+            h,
+            FailureReason::NoConvergence(self.newton.max_iterations),
+            history,
+            fref,
+        ))
+    }
+}

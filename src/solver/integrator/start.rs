@@ -1,0 +1,185 @@
+//! The start of a run: reference magnitudes of the iteration matrix and the consistent
+//! initial (or restart) accelerations and multipliers.
+
+use super::*;
+
+impl Integrator {
+    /// Reference magnitudes of the mass and stiffness diagonals, and the consistent
+    /// initial accelerations (and multipliers) from the equations of motion at t = 0:
+    /// `[M  sBᵀ; sB  0] [v̇₀; λ̂₀] = [−r(q₀, v₀, 0); 0]` (acceleration-level constraints of
+    /// scleronomic joints, exact for a start from rest).
+    pub fn initialize(&mut self) -> Result<(), Failure> {
+        let n = self.sys.n_eq();
+        let nn = self.sys.n_node_eq;
+        // An over-constrained mechanism makes every iteration matrix singular: stop at
+        // once, naming the redundant joints.
+        if n > nn
+            && let Some(msg) = crate::solver::redundancy::redundancy_error(&self.sys, &self.nodes)
+        {
+            return Err(self.failure(
+                0.0,
+                FailureReason::Singular(msg),
+                vec![],
+                self.sys.ref_force,
+            ));
+        }
+        // Stiffness part (c_a = 0), then with c_a = 1: the difference is the mass matrix.
+        let ctx0 = EvalContext {
+            c_v: 0.0,
+            c_a: 0.0,
+            ..self.context(0.0, 0.0, 1.0)
+        };
+        let zero = vec![0.0; n];
+        self.sys.assemble(&ctx0, &self.nodes, &zero, true);
+        let k_vals = self.sys.matrix.values.clone();
+        let ctx1 = EvalContext { c_a: 1.0, ..ctx0 };
+        self.sys.assemble(&ctx1, &self.nodes, &zero, true);
+        let (mut msum, mut ksum, mut kmax, mut cnt) = (0.0, 0.0, 0.0f64, 0usize);
+        let (mut jsum, mut jcnt) = (0.0, 0usize);
+        for eq in 0..nn {
+            if let crate::solver::system::DofOwner::Node { comp, .. } = self.sys.owners[eq]
+                && let Some(p) = self.sys.matrix.position(eq, eq)
+            {
+                if comp < 3 {
+                    msum += (self.sys.matrix.values[p] - k_vals[p]).abs();
+                    ksum += k_vals[p].abs();
+                    kmax = kmax.max(k_vals[p].abs());
+                    cnt += 1;
+                } else {
+                    jsum += (self.sys.matrix.values[p] - k_vals[p]).abs();
+                    jcnt += 1;
+                }
+            }
+        }
+        self.rot_mass_ref = jsum / jcnt.max(1) as f64;
+        let cnt = cnt.max(1) as f64;
+        self.mass_ref = msum / cnt;
+        self.stiff_ref = ksum / cnt;
+        self.residual_floor = 10.0 * f64::EPSILON * kmax * self.sys.ref_length;
+        if self.mass_ref == 0.0 && self.stiff_ref == 0.0 {
+            self.stiff_ref = 1.0;
+        }
+        if !self.dynamic {
+            self.scale = self.scale_for(0.0);
+            return Ok(());
+        }
+        self.consistent_accelerations()
+    }
+
+    /// Consistent accelerations and multipliers at the current state, from the equations
+    /// of motion `[M  sBᵀ; sB  0] [v̇; λ̂] = [−r(q, v, 0); −s Ḃv]`; the pseudo-accelerations
+    /// restart from them (`a = v̇`). Used at `t = 0` and after an element switched its force
+    /// law ([`crate::elements::Element::restart`]): a restart costs one local error of
+    /// `O(h²)` in the velocities, which keeps the scheme second-order, while a step across
+    /// the jump would cost `O(h)`.
+    pub fn consistent_accelerations(&mut self) -> Result<(), Failure> {
+        let n = self.sys.n_eq();
+        let nn = self.sys.n_node_eq;
+        let ctx0 = EvalContext {
+            c_v: 0.0,
+            c_a: 0.0,
+            ..self.context(self.t, 0.0, 1.0)
+        };
+        let ctx1 = EvalContext { c_a: 1.0, ..ctx0 };
+        let zero = vec![0.0; n];
+        // The residual's inertia terms use the nodes' accelerations: clear them, so that
+        // the solution is the acceleration itself, not a correction to it.
+        for s in &mut self.nodes {
+            s.a = Vector3::zeros();
+            s.wd = Vector3::zeros();
+        }
+        self.scale = self.scale_for(0.0).max(self.mass_ref);
+        // Build [M, sBᵀ; sB, 0] from the two assemblies.
+        let s = self.scale;
+        let ctx_s = EvalContext {
+            constraint_scale: s,
+            ..ctx0
+        };
+        self.sys.assemble(&ctx_s, &self.nodes, &zero, true);
+        let kb = self.sys.matrix.values.clone();
+        let ctx_m = EvalContext {
+            constraint_scale: s,
+            ..ctx1
+        };
+        let info = self.sys.assemble(&ctx_m, &self.nodes, &zero, true);
+        let mut rhs: Vec<f64> = self.sys.rhs.iter().map(|r| -r).collect();
+        for eq in 0..n {
+            let a = self.sys.matrix.position_range(eq);
+            for p in a {
+                let row = self.sys.matrix.row_of(p);
+                if row < nn && eq < nn {
+                    self.sys.matrix.values[p] -= kb[p];
+                }
+            }
+        }
+        // Acceleration-level constraints: s(B v̇ + Ḃv) = 0. The velocity term Ḃv is the
+        // second derivative of Φ along the geodesic q exp(εv) (constant velocities), taken by
+        // a central second difference (truncation O(ε²), ε|v| = 1e-3 L_ref; it is zero for
+        // a start from rest and gives e.g. the centripetal tension of a launched pendulum).
+        let (vmax, wmax) = self.nodes.iter().fold((0.0f64, 0.0f64), |(a, b), s| {
+            (a.max(s.v.norm()), b.max(s.w.norm()))
+        });
+        let mut bdot_v = vec![0.0; n - nn];
+        if n > nn && (vmax > 0.0 || wmax > 0.0) {
+            let eps = (1e-3 * self.sys.ref_length / vmax.max(1e-300)).min(1e-3 / wmax.max(1e-300));
+            let moved = |sign: f64, nodes: &[NodeState]| -> Vec<NodeState> {
+                nodes
+                    .iter()
+                    .map(|s| NodeState {
+                        x: s.x + s.v * (sign * eps),
+                        r: s.r * rotation::exp(&(s.w * (sign * eps))),
+                        ..*s
+                    })
+                    .collect()
+            };
+            let plus = moved(1.0, &self.nodes);
+            let minus = moved(-1.0, &self.nodes);
+            self.sys.assemble(&ctx_s, &self.nodes, &zero, false);
+            let r0: Vec<f64> = self.sys.rhs[nn..].to_vec();
+            self.sys.assemble(&ctx_s, &plus, &zero, false);
+            let rp: Vec<f64> = self.sys.rhs[nn..].to_vec();
+            self.sys.assemble(&ctx_s, &minus, &zero, false);
+            for (k, b) in bdot_v.iter_mut().enumerate() {
+                *b = (rp[k] - 2.0 * r0[k] + self.sys.rhs[nn + k]) / (eps * eps);
+            }
+        }
+        for (r, b) in rhs.iter_mut().skip(nn).zip(&bdot_v) {
+            *r = -b;
+        }
+        self.lu_step = f64::NAN;
+        if let Err(e) = self.sys.matrix.factor() {
+            return Err(self.failure(
+                0.0,
+                FailureReason::Singular(e.to_string()),
+                vec![],
+                info.force_scale,
+            ));
+        }
+        self.stats.factorizations += 1;
+        let _ = self.sys.matrix.solve(&mut rhs);
+        if rhs.iter().any(|v| !v.is_finite()) {
+            return Err(self.failure(
+                0.0,
+                FailureReason::Singular("initial accelerations are not finite (singular mass matrix: a node with rotational or translational freedom but no inertia?)".into()),
+                vec![],
+                info.force_scale,
+            ));
+        }
+        for (i, d) in self.sys.node_dofs.iter().enumerate() {
+            for c in 0..6 {
+                if d[c] != crate::solver::system::FIXED {
+                    let v = rhs[d[c]];
+                    if c < 3 {
+                        self.nodes[i].a[c] = v;
+                        self.pseudo[i][0][c] = v;
+                    } else {
+                        self.nodes[i].wd[c - 3] = v;
+                        self.pseudo[i][1][c - 3] = v;
+                    }
+                }
+            }
+        }
+        self.lambda[nn..n].copy_from_slice(&rhs[nn..n]);
+        Ok(())
+    }
+}
