@@ -316,8 +316,8 @@ const DERIVED: &[(&str, &str, &[Diff])] = &[
         "pendulum_flexible1.dat",
         &[Mesh, Step, End, Output],
     ),
-    // The triangle of Fig. 2 replaced by a haversine pulse (the torque is load 1).
-    ("pendulum_haversine.dat", "pendulum.dat", &[LoadFunction(1)]),
+    // The triangle of Fig. 2 replaced by a haversine pulse (the torque, the only nodal load: load 0).
+    ("pendulum_haversine.dat", "pendulum.dat", &[LoadFunction(0)]),
     ("pendulum_short.dat", "pendulum.dat", &[End]),
     // At its PARAMETERS' values.
     ("pendulum_sweep.dat", "pendulum.dat", &[Output]),
