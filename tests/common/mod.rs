@@ -67,3 +67,16 @@ impl Drop for TempDir {
         let _ = std::fs::remove_dir_all(&self.path);
     }
 }
+
+/// Fails the test, saying why, when the binary under test has no failure-injection hook
+/// (`MECANO_FAILPOINT`, `src/failpoint.rs`): a build without debug assertions and without the
+/// feature `failpoints` (`cargo test --release` alone) would otherwise fail these tests in
+/// ways that point elsewhere. The library and the binary are built in the same profile and
+/// with the same features as this test, so `mecano::failpoint::ENABLED` speaks for both.
+pub fn require_failpoints() {
+    assert!(
+        mecano::failpoint::ENABLED,
+        "this test stops runs with MECANO_FAILPOINT, which this build does not have: \
+         run it with debug assertions (`cargo test`) or `--features failpoints`"
+    );
+}
