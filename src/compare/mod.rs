@@ -17,7 +17,12 @@
 //! tolerance are reported, not judged. Exit codes: 0 every judged difference within its
 //! tolerance (or none judged), 1 one exceeds it, 2 bad input (a missing directory, file,
 //! node, element or column, named with what is available).
+//!
+//! Rotations are compared as rotations ([`rotation`]): a node's `rx, ry, rz` are reported as
+//! one column `rotation`, the angle of `R_runᵀ R_ref` (rad), judged by the `rotation`
+//! tolerance. `energy.csv` is compared too, as a history file like the others.
 
+mod rotation;
 mod table;
 
 use crate::app::{EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK};
@@ -320,6 +325,7 @@ pub fn compare_histories(
     let mut out = Vec::new();
     let mut compared = 0;
     let mut outside = 0;
+    let (columns, by_rotation) = rotation::split(columns, run, reference);
     for (ci, name) in columns.iter().enumerate() {
         let (Some(cr), Some(cf)) = (
             run.header.iter().position(|h| h == name),
@@ -377,6 +383,15 @@ pub fn compare_histories(
             pass,
         });
     }
+    if by_rotation {
+        let tv = tol.of(rotation::NAME);
+        let (c, cmp_rows, out_rows) =
+            rotation::compare(run, reference, same_times, window, n_win, tv);
+        if out.is_empty() || cmp_rows > compared {
+            (compared, outside) = (cmp_rows, out_rows);
+        }
+        out.push(c);
+    }
     FileReport {
         file: file.to_string(),
         rows_compared: compared,
@@ -398,6 +413,9 @@ fn histories(dir: &Path) -> Result<BTreeMap<(String, u32), String>, CompareError
     let mut out = BTreeMap::new();
     for e in rd.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
+        if name == "energy.csv" {
+            out.insert(("energy".to_string(), 0), name.clone());
+        }
         for kind in ["node", "element"] {
             if let Some(n) = name
                 .strip_prefix(kind)
