@@ -2,7 +2,9 @@
 //! rotations, the geometrically exact BEAM, HHT and Newton). Every case runs a deck from
 //! `decks/`; tolerances are derived in the comments next to them.
 
-use mecano::deck::load_deck;
+mod common;
+
+use common::deck;
 use mecano::elements::NodeState;
 use mecano::model::{Function, Model, NodeId};
 use mecano::output::History;
@@ -10,16 +12,6 @@ use mecano::rotation;
 use mecano::solver;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
-use std::path::Path;
-
-fn deck(name: &str) -> Model {
-    load_deck(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("decks")
-            .join(name),
-    )
-    .unwrap_or_else(|e| panic!("{name}: {e:?}"))
-}
 
 fn run(model: &Model, every: u64) -> History {
     let mut h = History::new(every);

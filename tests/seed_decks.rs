@@ -23,8 +23,8 @@ mod common;
 use common::{deck, deck_path};
 use mecano::deck::{load_deck, parse_deck, strip_spans};
 use mecano::model::{
-    Analysis, Element, ElementId, ElementKind, Fixity, Function, Material, MaterialId, Model, NodeId,
-    Section, SectionId, Selection,
+    Analysis, Element, ElementId, ElementKind, Fixity, Function, Material, MaterialId, Model,
+    NodeId, Section, SectionId, Selection,
 };
 use mecano::scenes::{PendulumSettings, pendulum_deck, pendulum_order_deck};
 use nalgebra::Vector3;
@@ -202,7 +202,11 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
     }
 
     let others: Vec<&Element> = m.elements.values().filter(|e| !is_beam(e)).collect();
-    let node_ref = |n: &NodeId| label.get(n).map_or(Ref::Raw(u64::from(n.0)), |&k| Ref::Key(k));
+    let node_ref = |n: &NodeId| {
+        label
+            .get(n)
+            .map_or(Ref::Raw(u64::from(n.0)), |&k| Ref::Key(k))
+    };
     let element_ref = |e: &ElementId| {
         if let Some(k) = others.iter().position(|o| o.id == *e) {
             Ref::Other(k)
@@ -368,7 +372,12 @@ fn the_generated_decks_are_the_seed_cases() {
             let diffs: &[Diff] = if output { &[Mesh] } else { &[Mesh, Output] };
             for n in [1, 2, 10, 20, 80] {
                 let m = parse_deck(&pendulum_deck(n, &s), "generated").expect("parses");
-                assert_same_case(&format!("pendulum_deck({n}), E = {young:e}"), &m, case, diffs);
+                assert_same_case(
+                    &format!("pendulum_deck({n}), E = {young:e}"),
+                    &m,
+                    case,
+                    diffs,
+                );
             }
             if output {
                 let m = parse_deck(&pendulum_deck(10, &s), "generated").expect("parses");

@@ -3,19 +3,13 @@
 //! in docs/stability.md). Cost at opt-level 2: about 95 s wall on 2 cores (≈ 100 s CPU; the
 //! two 100 s long runs are 60 % of it).
 
-use mecano::deck::load_deck;
+mod common;
+
+use common::deck;
 use mecano::model::{ElementId, ElementKind, Model, NodeId};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::f64::consts::PI;
-use std::path::Path;
-
-fn deck(name: &str) -> Model {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("decks")
-        .join(name);
-    load_deck(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"))
-}
 
 fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
     assert!(
@@ -98,7 +92,7 @@ fn max_of(v: &[f64]) -> f64 {
 /// and a bounded Newton effort: ≤ 4 matrix factorisations per step on average and ≤ 14
 /// (modified) Newton iterations (a contraction of at least 4 per iteration from a residual
 /// ≤ 1 to the 1e-8 tolerance; figures printed), and its tip follows the RIGID-body variant
-/// (`decks/pendulum_rigid_body.dat`; skipped, with a message, if that deck is absent) to
+/// (`decks/pendulum_rigid_body.dat`; a missing deck fails the test) to
 /// within 1e-3 m (measured 3.1e-5 m over 0.6 s).
 #[test]
 fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
@@ -108,11 +102,6 @@ fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
         "pendulum_rigid.dat",
         "pendulum_rigid_body.dat",
     ] {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks").join(d);
-        if !p.exists() {
-            println!("{d} absent: comparison skipped");
-            continue;
-        }
         let mut model = deck(d);
         set_steps(&mut model, 1e-4, 0.6, None);
         let tip = node(&model, 23);
@@ -143,22 +132,32 @@ fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
             .collect();
         out.push((d, traj));
     }
-    if out.len() == 3 {
-        // Compare at common times (both runs step at 1e-4 apart from impact refinement).
-        let (a, b) = (&out[1].1, &out[2].1);
-        let mut err: f64 = 0.0;
-        let mut j = 0;
-        for (t, x) in a {
-            while j + 1 < b.len() && b[j].0 < *t - 1e-9 {
-                j += 1;
-            }
-            if (b[j].0 - t).abs() < 1e-9 {
-                err = err.max((b[j].1 - x).norm());
-            }
+    // Compare at common times (both runs step at 1e-4 apart from impact refinement).
+    let (a, b) = (&out[1].1, &out[2].1);
+    let mut err: f64 = 0.0;
+    let (mut j, mut shared) = (0, 0);
+    for (t, x) in a {
+        while j + 1 < b.len() && b[j].0 < *t - 1e-9 {
+            j += 1;
         }
-        println!("rigid beams vs RIGID bodies: max tip distance {err:.2e} m over 0.6 s");
-        assert!(err < 1e-3, "{err:e} m");
+        if (b[j].0 - t).abs() < 1e-9 {
+            err = err.max((b[j].1 - x).norm());
+            shared += 1;
+        }
     }
+    println!(
+        "rigid beams vs RIGID bodies: max tip distance {err:.2e} m over 0.6 s, {shared} of {} instants shared",
+        a.len()
+    );
+    // The 6000 steps of 1e-4 s are on both runs' grids; only the impact's refined steps
+    // (a few tens) may differ: at least 90 % shared, or the distance means nothing.
+    assert!(
+        shared * 10 >= a.len() * 9 && shared * 10 >= b.len() * 9,
+        "{shared} instants shared of {} and {}",
+        a.len(),
+        b.len()
+    );
+    assert!(err < 1e-3, "{err:e} m");
 }
 
 // ---------------------------------------------------------------- stiff contact
@@ -660,13 +659,13 @@ fn a_diverging_run_fails_cleanly() {
 }
 
 fn fails_cleanly(name: &str) {
-    let dir = std::env::temp_dir().join(format!("mecano_{name}_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("decks/{name}.dat"));
+    let scratch = common::TempDir::new(name);
+    let dir = scratch.path();
+    let deck = common::deck_path(&format!("{name}.dat"));
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
         .arg(&deck)
         .arg("-o")
-        .arg(&dir)
+        .arg(dir)
         .output()
         .expect("binary runs");
     let err = String::from_utf8_lossy(&out.stderr);
@@ -698,7 +697,7 @@ fn fails_cleanly(name: &str) {
     );
     assert!(summary["failure"]["time"].as_f64().is_some());
     let mut files = 0;
-    for f in std::fs::read_dir(&dir).unwrap() {
+    for f in std::fs::read_dir(dir).unwrap() {
         let p = f.unwrap().path();
         let text = std::fs::read_to_string(&p).unwrap();
         let low = text.to_ascii_lowercase();
@@ -710,5 +709,4 @@ fn fails_cleanly(name: &str) {
         files += 1;
     }
     assert!(files >= 3);
-    let _ = std::fs::remove_dir_all(&dir);
 }
