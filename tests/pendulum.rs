@@ -422,16 +422,6 @@ fn case(case: &str, windows: &[Window], e: f64) -> Record {
     rec
 }
 
-/// The largest |z| of node 12 over the converged windows (to 1.0 s), from the golden files:
-/// the cross-case ordering test needs no extra run.
-fn golden_z12(case: &str, until: f64) -> f64 {
-    read_golden(case)
-        .iter()
-        .filter(|(t, _)| *t <= until)
-        .map(|(_, s)| s[0].x.z.abs())
-        .fold(0.0, f64::max)
-}
-
 #[test]
 fn rigid() {
     let rec = case("rigid", RIGID, 2.1e15);
@@ -498,17 +488,53 @@ fn rigid_body() {
     }
 }
 
+/// Node 12's largest |z| over every accepted step, to `until`.
+struct MaxZ12 {
+    idx: usize,
+    z: f64,
+}
+
+impl Observer for MaxZ12 {
+    fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
+        self.z = self.z.max(snap.integ.nodes[self.idx].x.z.abs());
+        Ok(())
+    }
+}
+
+/// The paper's trend, rigid ≪ flexible1 < flexible2, for node 12's largest out-of-plane
+/// displacement over the converged window (0–1 s), on fresh runs of the three decks (it read
+/// only the golden files, so a solver change could not make it fail; about 2 s of CPU).
+/// Each gap is far above the runs' own step error: in 0.5–1.0 s the h vs h/2 position
+/// differences (table above) are at most 6.5e-4 m (rigid) and 2.2e-3 m (flexible1), while
+/// flexible2's is 1.8e-2 m (0.6–1.0 s): the ordering means something only where each gap
+/// exceeds the sum of the two runs' errors, and that is what is asserted (measured values
+/// about 1e-5, 1.2e-2 and 4e-2 m, docs/sweeps.md, study (a), printed).
 #[test]
 fn out_of_plane_displacement_grows_with_flexibility() {
-    if regen() {
-        return;
-    }
     let z: Vec<f64> = ["rigid", "flexible1", "flexible2"]
         .iter()
-        .map(|c| golden_z12(c, 1.0))
+        .map(|c| {
+            let mut model =
+                mecano::deck::load_deck(&deck_path(c)).unwrap_or_else(|e| panic!("{c}: {e:?}"));
+            assert!(model.set_fixed_step(1e-4, 1.0, None));
+            let mut integ = solver::prepare(&model).expect("the model builds");
+            let idx = model
+                .nodes
+                .get_index_of(&mecano::model::NodeId(12))
+                .expect("node 12");
+            let mut obs = MaxZ12 { idx, z: 0.0 };
+            let r = solver::run_prepared(&model, &mut integ, &mut obs).expect("runs");
+            assert!(r.failure.is_none(), "{c}: {:?}", r.failure);
+            obs.z
+        })
         .collect();
+    eprintln!(
+        "node 12 max |z| to 1.0 s: rigid {:.2e}, flexible1 {:.2e}, flexible2 {:.2e} m",
+        z[0], z[1], z[2]
+    );
+    let (e_rigid, e_flex1, e_flex2) = (6.5e-4, 2.2e-3, 1.8e-2);
     assert!(
-        z[0] < z[1] && z[1] < z[2],
+        z[1] - z[0] > e_rigid + e_flex1 && z[2] - z[1] > e_flex1 + e_flex2,
         "node 12 max |z| to 1.0 s: {z:?}"
     );
 }
