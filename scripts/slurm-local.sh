@@ -11,11 +11,17 @@
 # needed), the node's CPUs and memory, no accounting, both daemons as root; munge with a
 # fresh key. `up` waits until the node is idle (a few seconds); `down` stops the daemons
 # by their pid files and is safe to run when nothing is up.
+#
+# It never touches a Slurm configuration it did not write: `up` refuses (exit 3, nothing
+# changed) when /etc/slurm/slurm.conf exists without the marker line below, which only this
+# script writes, so on a cluster node the site's scheduler, its spool directories and its
+# daemons are left alone. tests/slurm.rs runs it only with MECANO_SLURM_TEST=1 (.ci/run).
 set -euo pipefail
 
 RUN=/run/mecano-slurm
 CONF=/etc/slurm/slurm.conf
 NODE=$(hostname -s)
+MARK="# mecano-rs scripts/slurm-local.sh: a throw-away one-node cluster; this file may be rewritten."
 
 log() { echo "slurm-local: $*" >&2; }
 
@@ -36,6 +42,7 @@ write_conf() {
     mem=$(awk '/MemTotal/ { printf "%d", $2 / 1024 * 0.8 }' /proc/meminfo)
     mkdir -p /etc/slurm /var/spool/slurmctld /var/spool/slurmd /var/log/slurm "$RUN"
     cat > "$CONF" <<CONF
+$MARK
 # Written by mecano-rs scripts/slurm-local.sh: a one-node cluster on $NODE.
 ClusterName=mecano
 SlurmctldHost=$NODE
@@ -99,9 +106,19 @@ stop_pid() { # pid file, name
     fi
 }
 
+# Refuses (exit 3) when a Slurm configuration exists that this script did not write.
+ours_or_none() {
+    if [ -e "$CONF" ] && ! grep -qxF "$MARK" "$CONF"; then
+        log "$CONF exists and was not written by this script: refusing to touch this host's Slurm"
+        exit 3
+    fi
+}
+
 up() {
     [ "$(id -u)" = 0 ] || { log "needs root"; exit 1; }
+    ours_or_none
     install
+    ours_or_none # a package's postinst may have written one
     write_conf
     start_munge
     stop_pid "$RUN/slurmd.pid" slurmd

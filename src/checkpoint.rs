@@ -148,10 +148,10 @@ fn decode(path: &Path, bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
 
 /// Test hook: `MECANO_FAILPOINT=checkpoint:N` kills the process (SIGKILL, as a power cut
 /// or a scheduler would) half-way through writing the N-th checkpoint's temporary file,
-/// so that tests can check that the previous checkpoint survives. Unset: nothing.
+/// so that tests can check that the previous checkpoint survives. Unset, or a build without
+/// the hook ([`crate::failpoint`]): nothing.
 fn failpoint(count: u64) -> bool {
-    std::env::var("MECANO_FAILPOINT")
-        .ok()
+    crate::failpoint::var()
         .and_then(|v| v.strip_prefix("checkpoint:")?.parse::<u64>().ok())
         .is_some_and(|n| n == count)
 }

@@ -13,6 +13,7 @@ pub mod compare;
 pub mod deck;
 pub mod dual;
 pub mod elements;
+pub mod failpoint;
 pub mod figure;
 pub mod interrupt;
 pub mod lagrange;

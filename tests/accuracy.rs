@@ -1,21 +1,13 @@
 //! Accuracy controls: adaptive time stepping meets its tolerance against a fine fixed-step
 //! reference (issue: what accuracy costs in time).
 
-use mecano::deck::load_deck;
+mod common;
+
+use common::deck;
 use mecano::model::{Adaptive, Analysis, Model};
 use mecano::output::History;
 use mecano::solver::Stats;
 use mecano::{rotation, solver};
-use std::path::Path;
-
-fn deck(name: &str) -> Model {
-    load_deck(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("decks")
-            .join(name),
-    )
-    .expect("deck parses")
-}
 
 fn configure(m: &mut Model, h: f64, hmax: f64, tol: Option<f64>) {
     if let Analysis::Dynamic {

@@ -1,7 +1,9 @@
 //! No heap allocation in the step loop after the first steps (issue 7, "a fast step"):
 //! a counting global allocator wraps the system one and counts every allocation and
 //! reallocation while the pendulum of `decks/pendulum.dat` takes 50 steps — without
-//! output, and writing every node and element at every step.
+//! output, and writing every node and element at every step — and through its impact.
+
+mod common;
 
 use mecano::solver::{Observer, Snapshot};
 
@@ -82,11 +84,12 @@ fn writing_every_node_and_element_every_step_does_not_allocate() {
     model.output.nodes = mecano::model::Selection::All;
     model.output.elements = mecano::model::Selection::All;
     model.output.every = 1;
-    let dir = std::env::temp_dir().join(format!("mecano_alloc_{}", std::process::id()));
+    let scratch = common::TempDir::new("alloc");
+    let dir = scratch.path();
     let mut integ = mecano::solver::prepare(&model).expect("prepare");
     integ.initialize().expect("initial accelerations");
     let mut writer =
-        mecano::output::Writer::create(&dir, "pendulum.dat", &model, &integ.sys).expect("files");
+        mecano::output::Writer::create(dir, "pendulum.dat", &model, &integ.sys).expect("files");
     let h = 1e-4;
     let mut step = 0;
     let mut go = |integ: &mut mecano::solver::Integrator, writer: &mut mecano::output::Writer| {
@@ -102,7 +105,6 @@ fn writing_every_node_and_element_every_step_does_not_allocate() {
     }
     let (ok, n) = allocations_in(|| (0..50).all(|_| go(&mut integ, &mut writer)));
     drop(writer);
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(ok, "a step failed");
     assert_eq!(n, 0, "{n} heap allocations in 50 steps with their output");
 }
@@ -126,4 +128,90 @@ fn the_step_loop_of_high_order_beams_does_not_allocate() {
     let (ok, n) = allocations_in(|| (0..50).all(|_| integ.try_step(h).is_ok()));
     assert!(ok, "a step failed");
     assert_eq!(n, 0, "{n} heap allocations in 50 steps");
+}
+
+/// From the first accepted state at or after `from` to the first at or after `to`: this
+/// thread's allocations in each step (between two states; the observer allocates nothing),
+/// as `(allocations, the step restarted the accelerations at an event)`.
+struct CountBetween {
+    from: f64,
+    to: f64,
+    restarts: u64,
+    steps: Vec<(u64, bool)>,
+    done: bool,
+}
+
+impl Observer for CountBetween {
+    fn state(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let (t, restarts) = (
+            snap.integ.t,
+            snap.integ.stats.restarts + snap.integ.stats.rejected_steps,
+        );
+        let on = COUNTING.with(Cell::get);
+        COUNTING.with(|c| c.set(false));
+        if on {
+            let n = ALLOCS.with(Cell::get);
+            self.steps.push((n, restarts > self.restarts));
+        }
+        self.restarts = restarts;
+        if !self.done && t >= self.from && t < self.to {
+            ALLOCS.with(|a| a.set(0));
+            COUNTING.with(|c| c.set(true));
+        } else if t >= self.to {
+            self.done = true;
+        }
+        Ok(())
+    }
+}
+
+/// The contact path (issue 27 §1d: the tests above cover steps 6–55, long before the
+/// impact): the whole solver loop (`solver::run_prepared`: step controller, the CAME's event
+/// landing and refused steps, the impact's shortened steps, the restarts of the
+/// accelerations at the events) from t = 0.52 s to 0.56 s, through the first impact of node
+/// 23 at 0.533 s. The window holds more steps than its 400 of h = 1e-4 s (the impact's
+/// refined steps are in it) and at least one event.
+///
+/// KNOWN TO FAIL (ignored until fixed): measured 27 allocations in the window's 406 steps,
+/// 25 of them in the 4 steps that restart the accelerations or follow a refused attempt
+/// (`Integrator::consistent_accelerations` builds its right-hand sides and a copy of the
+/// matrix afresh), 2 in other steps of the impact. Run it with `cargo test --test alloc --
+/// --ignored`.
+#[test]
+#[ignore = "the contact path allocates (27 allocations through the impact): issue 27 §1d"]
+fn the_contact_path_does_not_allocate() {
+    let mut model = common::deck("pendulum.dat");
+    model.output.nodes = mecano::model::Selection::None;
+    model.output.elements = mecano::model::Selection::None;
+    assert!(model.set_fixed_step(1e-4, 0.57, None));
+    let mut integ = mecano::solver::prepare(&model).expect("prepare");
+    let mut obs = CountBetween {
+        from: 0.52,
+        to: 0.56,
+        restarts: 0,
+        steps: Vec::new(),
+        done: false,
+    };
+    let r = mecano::solver::run_prepared(&model, &mut integ, &mut obs).expect("runs");
+    COUNTING.with(|c| c.set(false));
+    assert!(r.failure.is_none(), "{:?}", r.failure);
+    let steps = &obs.steps;
+    let events = steps.iter().filter(|s| s.1).count();
+    let at_events: u64 = steps.iter().filter(|s| s.1).map(|s| s.0).sum();
+    eprintln!(
+        "0.52-0.56 s: {} steps, {events} with a restart or a refused attempt, {at_events} allocations in them",
+        steps.len()
+    );
+    assert!(
+        steps.len() > 400,
+        "{} steps: no refined impact steps",
+        steps.len()
+    );
+    assert!(events >= 1, "no contact event in 0.52-0.56 s");
+    let elsewhere: u64 = steps.iter().filter(|s| !s.1).map(|s| s.0).sum();
+    assert_eq!(
+        at_events + elsewhere,
+        0,
+        "heap allocations through the impact: {at_events} in the {events} steps with a restart or \
+         a refused attempt, {elsewhere} in the others"
+    );
 }

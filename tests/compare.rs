@@ -2,6 +2,9 @@
 //! where it was planted, with the exit codes of the README (0 pass, 1 over tolerance,
 //! 2 bad input).
 
+mod common;
+
+use common::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -35,10 +38,8 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
-#[test]
-fn compare_passes_identical_runs_and_finds_a_planted_difference() {
-    let base: PathBuf = std::env::temp_dir().join(format!("mecano_compare_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&base);
+/// `decks/pendulum_short.dat` run into `base/ref`.
+fn short_run(base: &TempDir) -> PathBuf {
     let reference = base.join("ref");
     let o = bin()
         .args(["decks/pendulum_short.dat", "-q", "--checkpoint", "0", "-o"])
@@ -46,6 +47,121 @@ fn compare_passes_identical_runs_and_finds_a_planted_difference() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    reference
+}
+
+/// Rewrites the columns `cols` of `dir/file` row by row with `f(t, values)`.
+fn rewrite(dir: &Path, file: &str, cols: &[usize], f: impl Fn(f64, &mut [f64])) {
+    let path = dir.join(file);
+    let t = std::fs::read_to_string(&path).unwrap();
+    let mut lines = t.lines();
+    let mut out = vec![lines.next().unwrap().to_string()];
+    for l in lines {
+        let mut v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        let mut picked: Vec<f64> = cols.iter().map(|&c| v[c]).collect();
+        f(v[0], &mut picked);
+        for (&c, x) in cols.iter().zip(picked) {
+            v[c] = x;
+        }
+        out.push(
+            v.iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+    }
+    std::fs::write(&path, out.join("\n") + "\n").unwrap();
+}
+
+/// Rotations are compared as rotations (issue 27 §3): node 23's rotation vector rewritten
+/// in every row as the same attitude, `Φ − 2π Φ/|Φ|` (2π away as numbers), is no difference
+/// (the angle of `R_runᵀ R_ref` is the rounding of exp and log, ~1e-15 rad; judged at 1e-12);
+/// a planted 1e-3 rad turn about x at t = 0.3 s is found as 1e-3 rad, where it was planted.
+/// `energy.csv` is compared too: a planted 1 J on its `kinetic` column is found.
+#[test]
+fn compare_judges_rotations_as_rotations_and_compares_the_energies() {
+    use mecano::rotation::{exp, log};
+    use nalgebra::Vector3;
+    let base = TempDir::new("compare_rot");
+    let reference = short_run(&base);
+    let run = base.join("run");
+    copy_dir(&reference, &run);
+    // node_<N>.csv: t,x,y,z,ux,uy,uz,rx,ry,rz,...
+    let rot = [7, 8, 9];
+    rewrite(&run, "node_23.csv", &rot, |_, r| {
+        let phi = Vector3::new(r[0], r[1], r[2]);
+        if phi.norm() > 0.0 {
+            let other = phi - phi.normalize() * (2.0 * std::f64::consts::PI);
+            r.copy_from_slice(other.as_slice());
+        }
+    });
+    let o = compare(
+        &run,
+        &reference,
+        &["--nodes", "23", "--tol", "rotation=1e-12", "--json"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let cols = v["files"][0]["columns"].as_array().unwrap();
+    assert!(cols.iter().any(|c| c["column"] == "rotation"), "{v}");
+    assert!(
+        !cols.iter().any(|c| c["column"] == "rx"),
+        "rx is not compared as a number"
+    );
+
+    rewrite(&run, "node_23.csv", &rot, |t, r| {
+        if (t - 0.3).abs() < 1e-9 {
+            let turned = exp(&Vector3::new(r[0], r[1], r[2])) * exp(&Vector3::new(1e-3, 0.0, 0.0));
+            r.copy_from_slice(log(&turned).as_slice());
+        }
+    });
+    let o = compare(
+        &run,
+        &reference,
+        &["--nodes", "23", "--tol", "rotation=1e-12", "--json"],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let cols = v["files"][0]["columns"].as_array().unwrap();
+    let m = &cols.iter().find(|c| c["column"] == "rotation").unwrap()["max"];
+    assert!((m["at_time"].as_f64().unwrap() - 0.3).abs() < 1e-9, "{m}");
+    // The planted turn composed with the rewritten vector: 1e-3 rad to a few ulps of π.
+    assert!(
+        (m["max_abs_diff"].as_f64().unwrap() - 1e-3).abs() < 1e-12,
+        "{m}"
+    );
+
+    // energy.csv: t,kinetic,...
+    rewrite(&run, "energy.csv", &[1], |t, e| {
+        if (t - 0.3).abs() < 1e-9 {
+            e[0] += 1.0;
+        }
+    });
+    let o = compare(
+        &run,
+        &reference,
+        &["--tol", "kinetic=1e-6,rotation=1", "--json"],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let energy = v["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["file"] == "energy.csv")
+        .expect("energy.csv compared");
+    let k = &energy["columns"].as_array().unwrap()[0];
+    assert_eq!(k["column"], "kinetic");
+    assert!(
+        (k["max"]["max_abs_diff"].as_f64().unwrap() - 1.0).abs() < 1e-9,
+        "{k}"
+    );
+}
+
+#[test]
+fn compare_passes_identical_runs_and_finds_a_planted_difference() {
+    let base = TempDir::new("compare");
+    let reference = short_run(&base);
 
     // Identical: every difference is exactly 0, within any tolerance, even 0.
     let o = compare(&reference, &reference, &["--tol", "0"]);
@@ -190,5 +306,4 @@ fn compare_passes_identical_runs_and_finds_a_planted_difference() {
     assert_eq!(o.status.code(), Some(2));
     let o = compare(&run, &reference, &["--tol", "x=-1"]);
     assert_eq!(o.status.code(), Some(2));
-    let _ = std::fs::remove_dir_all(&base);
 }

@@ -4,21 +4,15 @@
 //! Timoshenko frequencies — are unit tests in `src/elements/beam_p_tests.rs` and
 //! `beam_p_cases.rs`.)
 
-use mecano::deck::{load_deck, parse_deck, write_deck};
+mod common;
+
+use common::deck;
+use mecano::deck::{parse_deck, write_deck};
 use mecano::model::{Model, NodeId};
 use mecano::output::History;
 use mecano::solver;
 use nalgebra::Vector3;
 use std::path::Path;
-
-fn deck(name: &str) -> Model {
-    load_deck(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("decks")
-            .join(name),
-    )
-    .unwrap_or_else(|e| panic!("{name}: {e:?}"))
-}
 
 fn run(model: &Model, every: u64) -> History {
     let mut h = History::new(every);

@@ -5,12 +5,13 @@
 //! (The tangent checks of every joint type are unit tests in `src/elements/joints.rs`:
 //! the finite-difference harness is crate-private.)
 
-use mecano::deck::load_deck;
+mod common;
+
+use common::deck;
 use mecano::model::{Analysis, Model, NodeId};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
-use std::path::Path;
 
 /// One accepted state.
 #[derive(Debug, Clone)]
@@ -41,13 +42,6 @@ impl Observer for Collect {
         });
         Ok(())
     }
-}
-
-fn deck(name: &str) -> Model {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("decks")
-        .join(name);
-    load_deck(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"))
 }
 
 fn set_steps(model: &mut Model, h: f64, end: f64) {

@@ -3,6 +3,8 @@
 //! LU) and computing the initial accelerations never panics — it succeeds or returns an
 //! error (issue: hard cases stay numerically stable, item 3).
 
+mod common;
+
 use mecano::deck::parse_deck;
 use mecano::solver;
 use proptest::prelude::*;
@@ -11,8 +13,8 @@ const NUMBERS: &[&str] = &[
     "0", "-1", "1e-12", "1e12", "2", "0.5", "-0.5", "1e300", "13", "24", "7",
 ];
 
+/// The decks mutated; a missing one fails the test (it was silently dropped).
 fn decks() -> Vec<String> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("decks");
     [
         "pendulum.dat",
         "double_pendulum_rigid.dat",
@@ -20,7 +22,7 @@ fn decks() -> Vec<String> {
         "heavy_top.dat",
     ]
     .iter()
-    .filter_map(|d| std::fs::read_to_string(dir.join(d)).ok())
+    .map(|d| std::fs::read_to_string(common::deck_path(d)).expect("read"))
     .collect()
 }
 

@@ -422,16 +422,6 @@ fn case(case: &str, windows: &[Window], e: f64) -> Record {
     rec
 }
 
-/// The largest |z| of node 12 over the converged windows (to 1.0 s), from the golden files:
-/// the cross-case ordering test needs no extra run.
-fn golden_z12(case: &str, until: f64) -> f64 {
-    read_golden(case)
-        .iter()
-        .filter(|(t, _)| *t <= until)
-        .map(|(_, s)| s[0].x.z.abs())
-        .fold(0.0, f64::max)
-}
-
 #[test]
 fn rigid() {
     let rec = case("rigid", RIGID, 2.1e15);
@@ -465,12 +455,29 @@ fn flexible2() {
 /// (0–0.5 s), 5.7e-7 m, 9.2e-7 rad, 1.5e-5 m/s; during it (0.5–0.6 s) 3.2e-5 m, 3.4e-5 rad,
 /// 2.0e-2 m/s; after it (0.6–1.75 s) 2.6e-4 m, 1.4e-3 rad, 1.1e-3 m/s. The rigid case's own
 /// time-step error (h vs h/2, table above) is 5.2e-7 m / 8.1e-5 m / 6.9e-4 m in these
-/// windows. Tolerances: 3 × the larger of the two in each window; accelerations are not
-/// compared (impact spikes of 220 m/s² between the models).
+/// windows.
+///
+/// Tolerances, derived (issue 27 §1d; they were 3 × the differences they check): the two
+/// histories differ by (a) the golden's own step error, (b) the rigid-body run's, and (c) the
+/// models' difference, the elastic deflection of the E = 2.1e15 bars. (a) and (b): for the
+/// second-order HHT a run's error is ≈ Δ·2²/(2² − 1) = (4/3) Δ, Δ its h vs h/2 difference;
+/// the rigid-body run follows the same motion, so its Δ is taken as the rigid case's (table
+/// above, the window's largest): (8/3) Δ together. (c): a cantilever of length L = 1 m,
+/// EI = 2.1e15 × 8.3e-8 = 1.743e8 N·m², deflects by F L³/(3EI) and turns by F L²/(2EI) under
+/// a tip force F, by M L²/(2EI) and M L/EI under a moment M. Before the impact the load is
+/// the torque pulse, M ≤ 1000 N·m: 2.9e-6 m, 5.7e-6 rad, followed in its 10 ms rise at
+/// 2.9e-4 m/s. From the impact on, the contact force, F ≤ 35.7 kN (the rigid case's
+/// largest): 6.8e-5 m, 1.02e-4 rad, reached in about 2 ms: 3.4e-2 m/s (HHT only removes
+/// the vibration energy the impact leaves, so it bounds the later windows too).
+/// Accelerations are not compared (impact spikes of 220 m/s² between the models).
+/// Tolerance = (8/3) Δ + (c), per window and channel:
 const RIGID_BODY: &[Window] = &[
-    (0.0, 0.5, [1.8e-6, 2.8e-6, 4.5e-5, INF]),
-    (0.5, 0.6, [2.4e-4, 2.6e-4, 6.9e-2, INF]),
-    (0.6, 1.75, [2.1e-3, 9.0e-3, 2.5e-2, INF]),
+    // Δ: 5.2e-7 m, 5.4e-7 rad, 6.2e-6 m/s; (c): 2.9e-6 m, 5.7e-6 rad, 2.9e-4 m/s.
+    (0.0, 0.5, [4.3e-6, 7.1e-6, 3.1e-4, INF]),
+    // Δ: 8.1e-5 m, 8.8e-5 rad, 2.3e-2 m/s; (c): 6.8e-5 m, 1.02e-4 rad, 3.4e-2 m/s.
+    (0.5, 0.6, [2.8e-4, 3.4e-4, 9.5e-2, INF]),
+    // Δ (largest of 0.6–1.75 s): 6.9e-4 m, 3.0e-3 rad, 8.4e-3 m/s; (c) as above.
+    (0.6, 1.75, [1.9e-3, 8.1e-3, 5.6e-2, INF]),
 ];
 
 #[test]
@@ -498,17 +505,53 @@ fn rigid_body() {
     }
 }
 
+/// Node 12's largest |z| over every accepted step, to `until`.
+struct MaxZ12 {
+    idx: usize,
+    z: f64,
+}
+
+impl Observer for MaxZ12 {
+    fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
+        self.z = self.z.max(snap.integ.nodes[self.idx].x.z.abs());
+        Ok(())
+    }
+}
+
+/// The paper's trend, rigid ≪ flexible1 < flexible2, for node 12's largest out-of-plane
+/// displacement over the converged window (0–1 s), on fresh runs of the three decks (it read
+/// only the golden files, so a solver change could not make it fail; about 2 s of CPU).
+/// Each gap is far above the runs' own step error: in 0.5–1.0 s the h vs h/2 position
+/// differences (table above) are at most 6.5e-4 m (rigid) and 2.2e-3 m (flexible1), while
+/// flexible2's is 1.8e-2 m (0.6–1.0 s): the ordering means something only where each gap
+/// exceeds the sum of the two runs' errors, and that is what is asserted (measured values
+/// about 1e-5, 1.2e-2 and 4e-2 m, docs/sweeps.md, study (a), printed).
 #[test]
 fn out_of_plane_displacement_grows_with_flexibility() {
-    if regen() {
-        return;
-    }
     let z: Vec<f64> = ["rigid", "flexible1", "flexible2"]
         .iter()
-        .map(|c| golden_z12(c, 1.0))
+        .map(|c| {
+            let mut model =
+                mecano::deck::load_deck(&deck_path(c)).unwrap_or_else(|e| panic!("{c}: {e:?}"));
+            assert!(model.set_fixed_step(1e-4, 1.0, None));
+            let mut integ = solver::prepare(&model).expect("the model builds");
+            let idx = model
+                .nodes
+                .get_index_of(&mecano::model::NodeId(12))
+                .expect("node 12");
+            let mut obs = MaxZ12 { idx, z: 0.0 };
+            let r = solver::run_prepared(&model, &mut integ, &mut obs).expect("runs");
+            assert!(r.failure.is_none(), "{c}: {:?}", r.failure);
+            obs.z
+        })
         .collect();
+    eprintln!(
+        "node 12 max |z| to 1.0 s: rigid {:.2e}, flexible1 {:.2e}, flexible2 {:.2e} m",
+        z[0], z[1], z[2]
+    );
+    let (e_rigid, e_flex1, e_flex2) = (6.5e-4, 2.2e-3, 1.8e-2);
     assert!(
-        z[0] < z[1] && z[1] < z[2],
+        z[1] - z[0] > e_rigid + e_flex1 && z[2] - z[1] > e_flex1 + e_flex2,
         "node 12 max |z| to 1.0 s: {z:?}"
     );
 }

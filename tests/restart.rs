@@ -9,6 +9,9 @@
 //! handlers) or, for signals from outside, frozen with SIGSTOP first so that the signal
 //! lands during the run whatever the machine's speed. Each run costs ~0.3 s of CPU.
 
+mod common;
+
+use common::{TempDir, require_failpoints};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output};
 use std::sync::OnceLock;
@@ -20,14 +23,15 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mecano_restart_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch directory removed when the test ends, passed or failed (`common::TempDir`).
+fn tmp(name: &str) -> TempDir {
+    TempDir::new(&format!("restart_{name}"))
 }
 
 fn run(args: &[&str], failpoint: Option<&str>) -> Output {
+    if failpoint.is_some() {
+        require_failpoints();
+    }
     let mut c = bin();
     c.args(args);
     match failpoint {
@@ -45,11 +49,15 @@ fn text(o: &Output) -> String {
     )
 }
 
-/// The uninterrupted run (no checkpoints at all), computed once.
+/// The uninterrupted run (no checkpoints at all), computed once per process. Shared by the
+/// tests, so no guard can remove it: it lives in cargo's scratch folder for integration tests
+/// (`CARGO_TARGET_TMPDIR`, under `target/`, not the system's temporary folder), under a fixed
+/// name that each run of this file overwrites.
 fn reference() -> &'static Path {
     static REF: OnceLock<PathBuf> = OnceLock::new();
     REF.get_or_init(|| {
-        let d = tmp("reference").join("out");
+        let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("restart_reference");
+        let _ = std::fs::remove_dir_all(&d);
         let o = run(
             &[DECK, "-q", "--checkpoint", "0", "-o", d.to_str().unwrap()],
             None,
@@ -147,8 +155,9 @@ fn resume(dir: &Path) -> Output {
 }
 
 /// A run stopped by the failpoint `fp`; returns its output directory and output.
-fn stopped_run(name: &str, fp: &str, checkpoint: &str) -> (PathBuf, Output) {
-    let d = tmp(name).join("out");
+fn stopped_run(name: &str, fp: &str, checkpoint: &str) -> (TempDir, PathBuf, Output) {
+    let dir = tmp(name);
+    let d = dir.join("out");
     let o = run(
         &[
             DECK,
@@ -160,13 +169,13 @@ fn stopped_run(name: &str, fp: &str, checkpoint: &str) -> (PathBuf, Output) {
         ],
         Some(fp),
     );
-    (d, o)
+    (dir, d, o)
 }
 
 #[test]
 fn sigint_ends_at_a_step_with_whole_rows_and_resume_gives_identical_files() {
     // Step 2500 of 6004: before the impact (0.534 s, step ~5340).
-    let (d, o) = stopped_run("sigint", "signal:INT:2500", "60");
+    let (_dir, d, o) = stopped_run("sigint", "signal:INT:2500", "60");
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     assert!(text(&o).contains("mecano-rs resume"), "{}", text(&o));
     assert_whole_rows(&d);
@@ -195,7 +204,7 @@ fn sigint_ends_at_a_step_with_whole_rows_and_resume_gives_identical_files() {
 fn sigterm_during_the_impact_then_again_in_the_restart_then_complete() {
     // Stopped inside the contact phase (steps ~5340-5600), resumed, stopped again by
     // SIGTERM 100 steps further (the failpoint is read again by the restart), resumed.
-    let (d, o) = stopped_run("sigterm", "signal:TERM:5400", "60");
+    let (_dir, d, o) = stopped_run("sigterm", "signal:TERM:5400", "60");
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     assert_eq!(summary(&d)["signal"], "SIGTERM");
     assert_eq!(summary(&d)["stop"]["step"], 5400);
@@ -223,7 +232,7 @@ fn sigkill_at_several_steps_and_a_torn_row_are_cut_back_by_resume() {
     // hold whichever). A partial row is appended after the kill, as a write cut by a
     // power failure would leave it.
     for (k, step) in [300u64, 3100, 5450, 5990].into_iter().enumerate() {
-        let (d, o) = stopped_run(&format!("kill{k}"), &format!("signal:KILL:{step}"), "0.01");
+        let (_dir, d, o) = stopped_run(&format!("kill{k}"), &format!("signal:KILL:{step}"), "0.01");
         assert_eq!(o.status.code(), None, "killed by a signal: {}", text(&o));
         assert!(d.join("checkpoint.bin").exists());
         let node = d.join("node_23.csv");
@@ -246,7 +255,7 @@ fn sigkill_at_several_steps_and_a_torn_row_are_cut_back_by_resume() {
 fn a_kill_while_writing_a_checkpoint_leaves_the_previous_one() {
     // Killed half-way through the temporary file of the 3rd checkpoint (step 0 is the
     // 1st): checkpoint.bin is still the 2nd, whole, and the restart goes on from it.
-    let (d, o) = stopped_run("torn", "checkpoint:3", "0.01");
+    let (_dir, d, o) = stopped_run("torn", "checkpoint:3", "0.01");
     assert_eq!(o.status.code(), None, "{}", text(&o));
     assert!(d.join("checkpoint.bin.tmp").exists());
     let o = resume(&d);
@@ -257,8 +266,9 @@ fn a_kill_while_writing_a_checkpoint_leaves_the_previous_one() {
 
 /// Starts a run and freezes it (SIGSTOP) as soon as its first checkpoint (step 0) is
 /// written: a signal sent then lands during the run on any machine.
-fn frozen_run(name: &str) -> (PathBuf, Child) {
-    let d = tmp(name).join("out");
+fn frozen_run(name: &str) -> (TempDir, PathBuf, Child) {
+    let dir = tmp(name);
+    let d = dir.join("out");
     let child = bin()
         .args([
             DECK,
@@ -283,7 +293,7 @@ fn frozen_run(name: &str) -> (PathBuf, Child) {
     }
     // SAFETY: signals to our own child.
     unsafe { libc::kill(pid, libc::SIGSTOP) };
-    (d, child)
+    (dir, d, child)
 }
 
 fn signal(child: &Child, sig: libc::c_int) {
@@ -293,7 +303,7 @@ fn signal(child: &Child, sig: libc::c_int) {
 
 #[test]
 fn ctrl_c_from_outside_stops_cleanly_and_resumes() {
-    let (d, mut child) = frozen_run("outside");
+    let (_dir, d, mut child) = frozen_run("outside");
     signal(&child, libc::SIGINT);
     signal(&child, libc::SIGCONT);
     let st = child.wait().unwrap();
@@ -307,7 +317,7 @@ fn ctrl_c_from_outside_stops_cleanly_and_resumes() {
 
 #[test]
 fn a_second_signal_ends_within_the_step_with_whole_rows_and_the_last_checkpoint_resumes() {
-    let (d, mut child) = frozen_run("twice");
+    let (_dir, d, mut child) = frozen_run("twice");
     // Two different signals: a stopped process holds one pending signal of each kind.
     signal(&child, libc::SIGINT);
     signal(&child, libc::SIGTERM);
@@ -389,7 +399,7 @@ fn resume_refuses_an_edited_deck_another_deck_a_complete_or_failed_run_and_a_mis
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("would fail again"), "{}", text(&o));
     // A damaged checkpoint: refused by its checksum, not decoded.
-    let (d2, o) = stopped_run("damaged", "signal:INT:100", "60");
+    let (_dir2, d2, o) = stopped_run("damaged", "signal:INT:100", "60");
     assert_eq!(o.status.code(), Some(130), "{}", text(&o));
     let ck = d2.join("checkpoint.bin");
     let mut b = std::fs::read(&ck).unwrap();
@@ -510,5 +520,19 @@ fn resume_rebuilds_a_refined_run_with_its_parameter_overrides() {
         );
     }
     assert_eq!(summary(&stopped)["refine"], 2);
-    let _ = std::fs::remove_dir_all(&base);
+}
+
+/// The scratch directories of these tests are removed also when a test fails: a guard
+/// dropped while a panic unwinds removes its directory and what it holds.
+#[test]
+fn a_scratch_directory_is_removed_when_its_test_panics() {
+    let path = std::panic::catch_unwind(|| {
+        let dir = tmp("panics");
+        std::fs::write(dir.join("out.csv"), "t\n0\n").expect("write");
+        std::panic::panic_any(dir.path().to_path_buf())
+    })
+    .expect_err("panicked")
+    .downcast::<PathBuf>()
+    .expect("the path");
+    assert!(!path.exists(), "{} left behind", path.display());
 }

@@ -6,21 +6,13 @@
 //! comparison is of the nodal states and multipliers at every later step, and of the
 //! counters and element summaries at the end, for exact equality.
 
-use mecano::deck::load_deck;
+mod common;
+
+use common::deck;
 use mecano::elements::NodeState;
 use mecano::model::{Adaptive, Analysis, Model};
 use mecano::solver::state::IntegratorState;
 use mecano::solver::{self, Integrator, LoopState, Observer, Pause, Snapshot};
-use std::path::Path;
-
-fn deck(name: &str) -> Model {
-    load_deck(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("decks")
-            .join(name),
-    )
-    .expect("deck parses")
-}
 
 /// Every accepted state (step, time bits, nodes, multipliers); the saved states at the
 /// chosen steps.

@@ -1,21 +1,15 @@
 //! The stability suite (issue 8): hard cases users of MECANO-style codes hit, each on a deck
-//! from `decks/`, with the figures measured written next to the assertions (and collected
-//! in docs/stability.md). Cost at opt-level 2: about 95 s wall on 2 cores (≈ 100 s CPU; the
-//! two 100 s long runs are 60 % of it).
+//! from `decks/`. The tests print what they measure (`-- --nocapture`); the figures are
+//! recorded in one place, docs/stability.md (with the suite's cost), not repeated here, so
+//! that the two cannot disagree (issue 27 §1d).
 
-use mecano::deck::load_deck;
+mod common;
+
+use common::deck;
 use mecano::model::{ElementId, ElementKind, Model, NodeId};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::f64::consts::PI;
-use std::path::Path;
-
-fn deck(name: &str) -> Model {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("decks")
-        .join(name);
-    load_deck(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"))
-}
 
 fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
     assert!(
@@ -98,8 +92,8 @@ fn max_of(v: &[f64]) -> f64 {
 /// and a bounded Newton effort: ≤ 4 matrix factorisations per step on average and ≤ 14
 /// (modified) Newton iterations (a contraction of at least 4 per iteration from a residual
 /// ≤ 1 to the 1e-8 tolerance; figures printed), and its tip follows the RIGID-body variant
-/// (`decks/pendulum_rigid_body.dat`; skipped, with a message, if that deck is absent) to
-/// within 1e-3 m (measured 3.1e-5 m over 0.6 s).
+/// (`decks/pendulum_rigid_body.dat`; a missing deck fails the test) to
+/// within 1e-3 m.
 #[test]
 fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
     let mut out = Vec::new();
@@ -108,11 +102,6 @@ fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
         "pendulum_rigid.dat",
         "pendulum_rigid_body.dat",
     ] {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks").join(d);
-        if !p.exists() {
-            println!("{d} absent: comparison skipped");
-            continue;
-        }
         let mut model = deck(d);
         set_steps(&mut model, 1e-4, 0.6, None);
         let tip = node(&model, 23);
@@ -143,22 +132,32 @@ fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
             .collect();
         out.push((d, traj));
     }
-    if out.len() == 3 {
-        // Compare at common times (both runs step at 1e-4 apart from impact refinement).
-        let (a, b) = (&out[1].1, &out[2].1);
-        let mut err: f64 = 0.0;
-        let mut j = 0;
-        for (t, x) in a {
-            while j + 1 < b.len() && b[j].0 < *t - 1e-9 {
-                j += 1;
-            }
-            if (b[j].0 - t).abs() < 1e-9 {
-                err = err.max((b[j].1 - x).norm());
-            }
+    // Compare at common times (both runs step at 1e-4 apart from impact refinement).
+    let (a, b) = (&out[1].1, &out[2].1);
+    let mut err: f64 = 0.0;
+    let (mut j, mut shared) = (0, 0);
+    for (t, x) in a {
+        while j + 1 < b.len() && b[j].0 < *t - 1e-9 {
+            j += 1;
         }
-        println!("rigid beams vs RIGID bodies: max tip distance {err:.2e} m over 0.6 s");
-        assert!(err < 1e-3, "{err:e} m");
+        if (b[j].0 - t).abs() < 1e-9 {
+            err = err.max((b[j].1 - x).norm());
+            shared += 1;
+        }
     }
+    println!(
+        "rigid beams vs RIGID bodies: max tip distance {err:.2e} m over 0.6 s, {shared} of {} instants shared",
+        a.len()
+    );
+    // The 6000 steps of 1e-4 s are on both runs' grids; only the impact's refined steps
+    // (a few tens) may differ: at least 90 % shared, or the distance means nothing.
+    assert!(
+        shared * 10 >= a.len() * 9 && shared * 10 >= b.len() * 9,
+        "{shared} instants shared of {} and {}",
+        a.len(),
+        b.len()
+    );
+    assert!(err < 1e-3, "{err:e} m");
 }
 
 // ---------------------------------------------------------------- stiff contact
@@ -250,13 +249,10 @@ fn stiff_contact_runs_and_never_creates_energy() {
 
 /// The simple pendulum (IFToMM A01, a HINGE with a 1 m offset, released from rest, α = −0.02)
 /// run to t = 0.05 s with h = 1e-2 … 1e-6 s: the Newton iterations per step do not grow as h
-/// shrinks (measured 2.00, 1.98, 1.00, 0.99, 0.99), the constraint holds (≤ 1e-11; measured
-/// ≤ 2.4e-15), and the multiplier — the hinge reaction on the mass — agrees with the exact
+/// shrinks, the constraint holds (≤ 1e-11), and the multiplier — the hinge reaction on the mass — agrees with the exact
 /// `F = m(a − g)` of the RK4 solution of `θ'' = −(g/L) cos θ` within the truncation bound
-/// plus the round-off bound derived below. Measured, relative to m g: 8.5e-4, 5.9e-6,
-/// 9.8e-7, 2.7e-5, 1.7e-2 (bounds 9.8e-3, 9.8e-5, 3.3e-6, 2.3e-4, 2.3e-2). Down to 1e-5 s
-/// the multipliers keep 5 digits; at 1e-6 s the index-3 formulation's round-off (ε L/(βh²)
-/// in the accelerations) is what is left, as derived. (Before the constraint rows got the
+/// plus the round-off bound derived below: at 1e-6 s the index-3 formulation's round-off
+/// (ε L/(βh²) in the accelerations) is what is left, as derived. (Before the constraint rows got the
 /// force tolerance, h = 1e-4 gave 6.6e-3: the absolute 1e-11 m tolerance on Φ, divided by
 /// βh², rang in the multipliers.)
 ///
@@ -347,12 +343,8 @@ fn step_range_keeps_iterations_and_multipliers() {
 /// at this step — and stop with a clean failure near t = 2.3 s: see
 /// `decks/stab_pendulum_undamped.dat` and `a_diverging_run_fails_cleanly`), `E − W_ext`
 /// never rises above E(0), and its drift is reported.
-///
-/// Measured (h = 1e-3, release): α = −0.1: never above E(0); loss over 100 s 113 J (0.64 of
-/// the largest kinetic energy, 177 J); local rises over the running minimum up to 1.2e-2 of
-/// it (the physical energy of HHT is not monotone, only bounded: the scheme dissipates a
-/// modified energy). α = −0.02: never above E(0), loss 137 J (0.77), local rises 1.5e-2.
-/// 20 s and 21 s of CPU (6.0 and 5.6 modified-Newton iterations per step).
+/// (The physical energy of HHT is not monotone, only bounded: the scheme dissipates a
+/// modified energy, so local rises over the running minimum are printed, not judged.)
 #[test]
 fn long_run_energy_never_increases_with_damping_and_stays_bounded() {
     for alpha in [-0.1, -0.02] {
@@ -524,8 +516,6 @@ impl Observer for RacketBeam {
 /// step that resolves every mode of the mesh (ωh < 0.3, see the deck): energy (kinetic +
 /// strain) and the angular momentum vector are conserved within 1e-4 relative, and the bar
 /// does flip (the body-frame spin of its centre node about Y reverses), with no singularity.
-/// Measured: energy 1.54e-6, angular momentum 8.4e-7, 44 flips; 250,000 steps, 3.9 (modified)
-/// Newton iterations per step, 3.7 s CPU (release).
 #[test]
 fn flexible_beam_about_the_intermediate_axis_conserves_energy_and_momentum() {
     let model = deck("stab_racket_beam.dat");
@@ -575,8 +565,7 @@ fn flexible_beam_about_the_intermediate_axis_conserves_energy_and_momentum() {
 /// upward zero crossings, `(E_N / E_0)^{1/(2 n)}` with n the steps between them; the period
 /// from the mean spacing of upward zero crossings (linear interpolation). Both agree with
 /// the closed form within 2e-3 (ρ) and 1e-3 + 3 % (period error; the zero-crossing
-/// interpolation at 6 steps per period is the limit: measured worst 0.1128 vs 0.1105 at
-/// α = −1/3, Ω = 1; elsewhere within 1e-4).
+/// interpolation at 6 steps per period is the limit, at α = −1/3, Ω = 1).
 #[test]
 fn hht_spectral_radius_and_period_error_match_the_closed_form() {
     let w: f64 = 100.0;
@@ -660,13 +649,13 @@ fn a_diverging_run_fails_cleanly() {
 }
 
 fn fails_cleanly(name: &str) {
-    let dir = std::env::temp_dir().join(format!("mecano_{name}_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("decks/{name}.dat"));
+    let scratch = common::TempDir::new(name);
+    let dir = scratch.path();
+    let deck = common::deck_path(&format!("{name}.dat"));
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
         .arg(&deck)
         .arg("-o")
-        .arg(&dir)
+        .arg(dir)
         .output()
         .expect("binary runs");
     let err = String::from_utf8_lossy(&out.stderr);
@@ -698,7 +687,7 @@ fn fails_cleanly(name: &str) {
     );
     assert!(summary["failure"]["time"].as_f64().is_some());
     let mut files = 0;
-    for f in std::fs::read_dir(&dir).unwrap() {
+    for f in std::fs::read_dir(dir).unwrap() {
         let p = f.unwrap().path();
         let text = std::fs::read_to_string(&p).unwrap();
         let low = text.to_ascii_lowercase();
@@ -710,5 +699,4 @@ fn fails_cleanly(name: &str) {
         files += 1;
     }
     assert!(files >= 3);
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,6 +3,8 @@
 //! that skip finished cases and restart interrupted ones, failed cases recorded, random
 //! plans, a 10,000-case plan listed and emitted without running, and bad input (exit 2).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -433,6 +435,7 @@ fn a_diverging_case_is_recorded_with_its_diagnosis() {
 /// history file of every case is byte for byte that of a sweep never stopped.
 #[test]
 fn an_interrupted_sweep_goes_on_from_its_checkpoints() {
+    common::require_failpoints();
     let clean = tmp("clean");
     let stopped = tmp("stopped");
     let (c, s) = (

@@ -35,9 +35,10 @@ impl CheckpointPlan {
 /// Test hook: `MECANO_FAILPOINT=signal:NAME:STEP` (NAME `INT`, `TERM` or `KILL`) sends the
 /// process that signal at the pause after step STEP, through the real handlers (and waits
 /// until they have seen it), so that tests stop a run at a known step rather than at a
-/// moment that depends on the machine's speed. (`checkpoint:N`: see [`crate::checkpoint`].) Unset: nothing.
+/// moment that depends on the machine's speed. (`checkpoint:N`: see [`crate::checkpoint`].) Unset,
+/// or a build without the hook ([`crate::failpoint`]): nothing.
 fn signal_failpoint() -> Option<(libc::c_int, u64)> {
-    let v = std::env::var("MECANO_FAILPOINT").ok()?;
+    let v = crate::failpoint::var()?;
     let mut it = v.strip_prefix("signal:")?.split(':');
     let sig = match it.next()? {
         "INT" => libc::SIGINT,

@@ -120,6 +120,7 @@ pub fn compare_histories(
     let mut out = Vec::new();
     let mut compared = 0;
     let mut outside = 0;
+    let (columns, by_rotation) = super::rotation::split(columns, run, reference);
     for (ci, name) in columns.iter().enumerate() {
         let (Some(cr), Some(cf)) = (
             run.header.iter().position(|h| h == name),
@@ -176,6 +177,15 @@ pub fn compare_histories(
             tolerance,
             pass,
         });
+    }
+    if by_rotation {
+        let tv = tol.of(super::rotation::NAME);
+        let (c, cmp_rows, out_rows) =
+            super::rotation::compare(run, reference, same_times, window, n_win, tv);
+        if out.is_empty() || cmp_rows > compared {
+            (compared, outside) = (cmp_rows, out_rows);
+        }
+        out.push(c);
     }
     FileReport {
         file: file.to_string(),

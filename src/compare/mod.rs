@@ -17,9 +17,14 @@
 //! tolerance are reported, not judged. Exit codes: 0 every judged difference within its
 //! tolerance (or none judged), 1 one exceeds it, 2 bad input (a missing directory, file,
 //! node, element or column, named with what is available).
+//!
+//! Rotations are compared as rotations ([`rotation`]): a node's `rx, ry, rz` are reported as
+//! one column `rotation`, the angle of `R_runᵀ R_ref` (rad), judged by the `rotation`
+//! tolerance. `energy.csv` is compared too, as a history file like the others.
 
 mod diff;
 mod history;
+mod rotation;
 mod table;
 mod tolerances;
 
@@ -115,6 +120,9 @@ fn histories(dir: &Path) -> Result<BTreeMap<(String, u32), String>, CompareError
     let mut out = BTreeMap::new();
     for e in rd.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
+        if name == "energy.csv" {
+            out.insert(("energy".to_string(), 0), name.clone());
+        }
         for kind in ["node", "element"] {
             if let Some(n) = name
                 .strip_prefix(kind)
