@@ -16,6 +16,7 @@ pub mod elements;
 pub mod interrupt;
 pub mod lagrange;
 pub mod model;
+pub mod modes;
 pub mod output;
 pub mod plot;
 pub mod rotation;
