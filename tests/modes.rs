@@ -223,3 +223,120 @@ fn rigid_seed_pendulum_about_its_hanging_equilibrium_matches_minimal_coordinates
     // compliance stays small, and the same independent model is met to it.
     check_hanging_pendulum("2.1e13");
 }
+
+fn mecano(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+#[test]
+fn cli_writes_the_modes_of_the_cantilever() {
+    let dir = std::env::temp_dir().join(format!("mecano_modes_cli_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = deck("cantilever_modes.dat");
+    let out = mecano(&[
+        "modes",
+        d.to_str().unwrap(),
+        "--count",
+        "8",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("modes.csv")).unwrap();
+    let f: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(f.len(), 8);
+    // Same targets as the library test, through the files (modes 1 and 3).
+    assert!((f[0] - TIMOSHENKO_HZ[0]).abs() <= 1e-6 * TIMOSHENKO_HZ[0] + 0.5e-5);
+    assert!((f[2] - TIMOSHENKO_HZ[1]).abs() <= 1e-6 * TIMOSHENKO_HZ[1] + 0.5e-5);
+    assert!(csv.starts_with("mode,kind,frequency_hz,natural_hz,damping_ratio,period_s,kinetic_BEAM,strain_BEAM,kinetic_MASS,strain_MASS"));
+    let shapes = std::fs::read_to_string(dir.join("modes_shapes.csv")).unwrap();
+    assert_eq!(
+        shapes.lines().count(),
+        1 + 8,
+        "one output node, eight modes"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["complete"], true);
+    assert_eq!(summary["rigid_modes"], 0);
+    assert!(!csv.contains("NaN") && !csv.contains("inf"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_requests_exit_2_and_write_nothing() {
+    let base = std::env::temp_dir().join(format!("mecano_modes_bad_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    // The four-bar's hinges are redundant (3 of 15 equations): one free unknown.
+    let four = deck("four_bar.dat");
+    let o = base.join("four");
+    let out = mecano(&[
+        "modes",
+        four.to_str().unwrap(),
+        "--count",
+        "2",
+        "-o",
+        o.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("2 modes asked for") && err.contains("1 free unknowns"),
+        "{err}"
+    );
+    assert!(!o.exists());
+    // --at past END.
+    let cant = deck("cantilever_modes.dat");
+    let out = mecano(&[
+        "modes",
+        cant.to_str().unwrap(),
+        "--at",
+        "5",
+        "-o",
+        o.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!o.exists());
+    // Nothing to vibrate: every node fixed.
+    let text = "TITLE fixed\nMATERIALS\n  1 E 2.1e11 NU 0.3 RHO 7800\nSECTIONS\n  1 A 9e-4 I2 8.3e-8 I3 8.3e-8 J 4.15e-8\nNODES\n  1 0 0 0 FIX ALL\n  2 1 0 0 FIX ALL\nELEMENTS\n  1 BEAM 1 2 MAT 1 SEC 1\nANALYSIS DYNAMIC STEP 1e-3 END 1\n";
+    std::fs::create_dir_all(&base).unwrap();
+    let p = base.join("fixed.dat");
+    std::fs::write(&p, text).unwrap();
+    let out = mecano(&["modes", p.to_str().unwrap(), "-o", o.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nothing to vibrate"));
+    assert!(!o.exists());
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+#[test]
+fn four_bar_mechanism_has_one_mode_and_check_reports_the_step() {
+    // Redundant constraints eliminated by the rank-revealing null space: one free motion.
+    let model = load(&deck("four_bar.dat"), &[], 1, None).unwrap();
+    let a = modes(&model, About::Initial, 1);
+    assert_eq!(a.free_unknowns, 1);
+    assert_eq!(
+        a.constraints.0 - a.constraints.1,
+        3,
+        "three redundant equations"
+    );
+    // --check states the highest frequency and what the step resolves.
+    let out = mecano(&["--check", deck("cantilever_modes.dat").to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("highest frequency") && text.contains("what the step resolves"),
+        "{text}"
+    );
+}

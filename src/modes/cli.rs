@@ -115,9 +115,18 @@ pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
     }
     let mut integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
     if about == About::Initial {
-        integ
-            .initialize()
-            .map_err(|f| failed(format!("the initial state: {f}")))?;
+        if let Err(f) = integ.initialize() {
+            // An over-constrained mechanism (the four-bar of hinges) has no unique
+            // multipliers, and runs refuse it; its modes are still defined: linearise
+            // with zero multipliers (exact when the constraints carry no force) and say so.
+            let crate::solver::FailureReason::Singular(why) = &f.reason else {
+                return Err(failed(format!("the initial state: {f}")));
+            };
+            eprintln!(
+                "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
+            );
+            integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
+        }
         return Ok(integ);
     }
     let report = solver::run_prepared(&m, &mut integ, &mut Quiet)
