@@ -190,6 +190,8 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
                 integ.sys.n_eq() - integ.sys.n_node_eq,
                 integ.sys.matrix.nnz()
             );
+            // The mesh's highest frequency and what the step resolves (issue 24).
+            crate::modes::cli::check_report(&model, &mut out);
             EXIT_OK
         }
         Err(e) => {

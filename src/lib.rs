@@ -18,6 +18,7 @@ pub mod figure;
 pub mod interrupt;
 pub mod lagrange;
 pub mod model;
+pub mod modes;
 pub mod output;
 pub mod plot;
 pub mod rotation;

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 /// `mecano-rs DECK` runs a deck; `mecano-rs resume OUTDIR` goes on after a stop;
 /// `mecano-rs compare RUN REF` compares the histories of two runs; `mecano-rs plot …`
 /// draws figures from a run's output; `mecano-rs study DECK` measures what accuracy costs
-/// in time.
+/// in time; `mecano-rs modes DECK` gives the linearised modes.
 ///
 /// Exit codes: 0 the run completed; 1 the run failed (diagnosis on standard error,
 /// histories kept and marked incomplete); 2 bad input (deck errors, nothing written);
@@ -84,6 +84,14 @@ restart is refused: no valid checkpoint, a complete run, or a deck whose text di
 1 one exceeds it; 2 bad input (a missing directory, file, node, element or column)."
     )]
     Compare(mecano::compare::CompareArgs),
+    /// Linearised modes: the lowest frequencies, damping ratios and shapes about the initial
+    /// state, the static equilibrium (--static) or a run's state at --at T; and what the
+    /// deck's step resolves of them.
+    #[command(
+        after_help = "Exit codes: 0 done; 1 the state could not be reached or the eigen-solve failed; \
+2 bad input (deck errors, --count above the free unknowns, --at outside the deck's time, nothing to vibrate)."
+    )]
+    Modes(mecano::modes::cli::ModesArgs),
     /// Parameter study: run the cases of a plan (TOML) in parallel, or emit a Slurm job
     /// array, and collect sweep.csv, statistics and figures.
     Sweep(mecano::sweep::SweepArgs),
@@ -97,6 +105,7 @@ fn main() -> ExitCode {
         (Some(Command::Resume(args)), _) => mecano::app::resume(args),
         (Some(Command::Compare(args)), _) => mecano::compare::run(args),
         (Some(Command::Sweep(args)), _) => mecano::sweep::run(args),
+        (Some(Command::Modes(args)), _) => mecano::modes::cli::run(args),
         (None, Some(deck)) if cli.check => mecano::app::check(deck, &cli.set, cli.refine),
         (None, Some(deck)) => mecano::app::run(
             deck,

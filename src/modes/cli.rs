@@ -1,0 +1,317 @@
+//! `mecano-rs modes DECK`: the lowest modes linearised about the initial state, the static
+//! equilibrium under the deck's loads (`--static`) or the state a run reaches at `--at T`.
+//!
+//! Exit codes: 0 done; 1 the state could not be reached (a failed static solve or run)
+//! or the eigen-solve failed; 2 bad input (deck errors, `--count` above the free
+//! unknowns, `--at` outside the deck's time, nothing to vibrate). Nothing is written
+//! unless the analysis succeeded.
+
+use super::output::{self, DeckStep};
+use super::{ModalAnalysis, ModesError};
+use crate::app::{self, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK};
+use crate::model::{Analysis, Model, Selection};
+use crate::solver::{self, Integrator, Observer, Snapshot};
+use clap::Args;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Options of `mecano-rs modes`.
+#[derive(Args, Debug, Clone)]
+pub struct ModesArgs {
+    /// The input deck.
+    pub deck: PathBuf,
+    /// Number of modes (the lowest; rigid motions first). Default: the deck's
+    /// `ANALYSIS MODES n`, else 10.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub count: Option<u32>,
+    /// Linearise about the static equilibrium under the deck's loads (an `ANALYSIS STATIC`
+    /// solve of one load step) instead of the initial state.
+    #[arg(long = "static", conflicts_with = "at")]
+    pub statics: bool,
+    /// Run the deck to time T (≤ its END) and linearise about the state reached.
+    #[arg(long, value_name = "T")]
+    pub at: Option<f64>,
+    /// Output directory (default: out/<deck name>/modes).
+    #[arg(short = 'o', long = "out", value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Divide every BEAM into K times its elements (as for runs).
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub refine: u32,
+    /// Set every beam to order P (as `mecano-rs study --order`).
+    #[arg(long, value_name = "P")]
+    pub order: Option<u32>,
+    /// Override a deck parameter: `--set E=2.1e10`; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = app::parse_set)]
+    pub set: Vec<(String, f64)>,
+    /// No table on standard output.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Where the linearisation is taken.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum About {
+    /// The initial state (consistent accelerations and multipliers at t = 0).
+    Initial,
+    /// The static equilibrium under the deck's loads.
+    Static,
+    /// The state a dynamic run reaches at this time.
+    At(f64),
+}
+
+/// A failure to reach the state or to solve, with its exit code.
+#[derive(Debug)]
+pub struct Failed {
+    /// Exit code (1 or 2).
+    pub code: u8,
+    /// Message.
+    pub message: String,
+}
+
+fn bad(message: String) -> Failed {
+    Failed {
+        code: EXIT_BAD_INPUT,
+        message,
+    }
+}
+
+fn failed(message: String) -> Failed {
+    Failed {
+        code: EXIT_FAILED,
+        message,
+    }
+}
+
+struct Quiet;
+impl Observer for Quiet {
+    fn state(&mut self, _snap: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The integrator at the state the analysis linearises about.
+pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
+    let newton = match &model.analysis {
+        Analysis::Dynamic { newton, .. } | Analysis::Static { newton, .. } => newton.clone(),
+    };
+    let mut m = model.clone();
+    match about {
+        About::Initial => {}
+        About::Static => m.analysis = Analysis::Static { steps: 1, newton },
+        About::At(t) => match &mut m.analysis {
+            Analysis::Dynamic { end, .. } => {
+                if !(t >= 0.0 && t <= *end) {
+                    return Err(bad(format!(
+                        "--at {t}: outside the deck's time span [0, {}] s",
+                        *end
+                    )));
+                }
+                *end = t;
+            }
+            Analysis::Static { .. } => {
+                return Err(bad("--at needs a deck with ANALYSIS DYNAMIC".into()));
+            }
+        },
+    }
+    let mut integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
+    if about == About::Initial {
+        if let Err(f) = integ.initialize() {
+            // An over-constrained mechanism (the four-bar of hinges) has no unique
+            // multipliers, and runs refuse it; its modes are still defined: linearise
+            // with zero multipliers (exact when the constraints carry no force) and say so.
+            let crate::solver::FailureReason::Singular(why) = &f.reason else {
+                return Err(failed(format!("the initial state: {f}")));
+            };
+            eprintln!(
+                "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
+            );
+            integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
+        }
+        return Ok(integ);
+    }
+    let report = solver::run_prepared(&m, &mut integ, &mut Quiet)
+        .map_err(|e| failed(format!("reaching the state: {e}")))?;
+    if let Some(f) = report.failure {
+        return Err(failed(format!("reaching the state: {f}")));
+    }
+    Ok(integ)
+}
+
+/// Modal analysis of a model at a state, `count` modes (the library's entry point).
+pub fn analyse_model(
+    model: &Model,
+    about: About,
+    count: usize,
+) -> Result<(Integrator, ModalAnalysis), Failed> {
+    let integ = reach_state(model, about)?;
+    let groups: Vec<&str> = model.elements.values().map(|e| e.kind.keyword()).collect();
+    let a = super::analyse(
+        &integ.sys,
+        &integ.nodes,
+        &integ.lambda,
+        integ.scale,
+        integ.t,
+        &groups,
+        count,
+    )
+    .map_err(|e| match e {
+        ModesError::Dense(d) => failed(d.to_string()),
+        other => bad(other.to_string()),
+    })?;
+    Ok((integ, a))
+}
+
+/// The deck's step and α when it is dynamic.
+pub fn deck_step(model: &Model) -> Option<DeckStep> {
+    match &model.analysis {
+        Analysis::Dynamic { alpha, step, .. } => Some(DeckStep {
+            alpha: *alpha,
+            h: *step,
+        }),
+        Analysis::Static { .. } => None,
+    }
+}
+
+/// Prints the modes and, for a dynamic deck, what its step resolves.
+pub fn print_table(out: &mut dyn std::io::Write, a: &ModalAnalysis, step: Option<DeckStep>) {
+    let _ = writeln!(
+        out,
+        "{} free unknowns, {} rigid modes, highest frequency {:.6e} Hz ({:?} solve)",
+        a.free_unknowns, a.rigid_modes, a.highest_hz, a.method
+    );
+    let _ = writeln!(out, " mode  kind       frequency Hz     damping ratio");
+    for (i, m) in a.modes.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "{:5}  {:9}  {:15.9e}  {:+.3e}",
+            i + 1,
+            format!("{:?}", m.kind).to_lowercase(),
+            m.natural_hz,
+            m.damping_ratio
+        );
+    }
+    if let Some(st) = step {
+        let _ = writeln!(
+            out,
+            "what the step resolves (HHT alpha {}, h = {:e} s): frequency Hz, samples per period, HHT damping ratio, period error",
+            st.alpha, st.h
+        );
+        let rows = output::step_resolution(a, st);
+        for (i, r) in rows.iter().enumerate() {
+            let label = if i + 1 == rows.len() { "highest" } else { "" };
+            let _ = writeln!(
+                out,
+                "  {:12.6e}  {:10.3e}  {:10.3e}  {:>10}  {label}",
+                r.frequency_hz,
+                r.samples_per_period,
+                r.hht_damping,
+                r.period_error
+                    .map_or("unresolved".to_string(), |e| format!("{e:.3e}"))
+            );
+        }
+    }
+}
+
+/// Dense solves are O(n³): `--check` reports modes only up to this many free unknowns.
+pub const CHECK_MAX_UNKNOWNS: usize = 1500;
+
+/// The lines `--check` adds: the mesh's highest frequency and what the deck's step
+/// resolves of the lowest five modes, about the initial state.
+pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
+    let Ok(integ) = solver::prepare(model) else {
+        return;
+    };
+    if integ.sys.n_node_eq > CHECK_MAX_UNKNOWNS {
+        let _ = writeln!(
+            out,
+            "modes:       not computed ({} unknowns > {CHECK_MAX_UNKNOWNS}: use mecano-rs modes)",
+            integ.sys.n_node_eq
+        );
+        return;
+    }
+    match analyse_model(model, About::Initial, 1) {
+        Ok((_, probe)) => {
+            let n = (probe.rigid_modes + 5).min(probe.finite_modes);
+            if let Ok((_, a)) = analyse_model(model, About::Initial, n) {
+                let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
+                print_table(out, &a, deck_step(model));
+            }
+        }
+        Err(f) => {
+            let _ = writeln!(out, "modes:       not computed ({})", f.message);
+        }
+    }
+}
+
+fn out_dir(args: &ModesArgs, model: &Model) -> PathBuf {
+    args.out
+        .clone()
+        .unwrap_or_else(|| app::default_out_dir(&args.deck, model).join("modes"))
+}
+
+fn shape_nodes(model: &Model) -> Vec<usize> {
+    match &model.output.nodes {
+        Selection::All => (0..model.nodes.len()).collect(),
+        Selection::List(ids) => ids
+            .iter()
+            .filter_map(|id| model.nodes.get_index_of(id))
+            .collect(),
+        Selection::None => Vec::new(),
+    }
+}
+
+/// Loads the deck with its overrides (`--set`, `--refine`, `--order`).
+pub fn load(
+    path: &Path,
+    set: &[(String, f64)],
+    refine: u32,
+    order: Option<u32>,
+) -> Result<Model, u8> {
+    let mut model = app::load_variant(path, set, refine)?;
+    if let Some(p) = order {
+        model.set_beam_order(p).map_err(|e| {
+            eprintln!("error: {}: --order {p}: {e}", path.display());
+            EXIT_BAD_INPUT
+        })?;
+    }
+    Ok(model)
+}
+
+/// `mecano-rs modes`: returns the exit code.
+pub fn run(args: &ModesArgs) -> u8 {
+    let model = match load(&args.deck, &args.set, args.refine, args.order) {
+        Ok(m) => m,
+        Err(code) => return code,
+    };
+    let about = match (args.statics, args.at) {
+        (true, _) => About::Static,
+        (false, Some(t)) => About::At(t),
+        (false, None) => About::Initial,
+    };
+    let count = args.count.map_or(10, |c| c as usize);
+    let (integ, a) = match analyse_model(&model, about, count) {
+        Ok(r) => r,
+        Err(f) => {
+            eprintln!("error: {}: {}", args.deck.display(), f.message);
+            return f.code;
+        }
+    };
+    let state = match about {
+        About::Initial => "initial".to_string(),
+        About::Static => "static equilibrium".to_string(),
+        About::At(t) => format!("run to t = {t} s"),
+    };
+    let step = deck_step(&model);
+    let summary = output::summary(&a, &args.deck.display().to_string(), &state, integ.t, step);
+    let dir = out_dir(args, &model);
+    if let Err(e) = output::write_all(&dir, &a, &integ.sys, &shape_nodes(&model), &summary) {
+        eprintln!("error: writing {}: {e}", dir.display());
+        return EXIT_FAILED;
+    }
+    if !args.quiet {
+        let mut out = std::io::stdout().lock();
+        print_table(&mut out, &a, step);
+        let _ = writeln!(out, "written: {}", dir.display());
+    }
+    EXIT_OK
+}

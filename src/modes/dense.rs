@@ -1,0 +1,219 @@
+//! Dense eigen-solvers of the reduced linearised problem `M ÿ + C ẏ + K y = 0`.
+//!
+//! **Conservative** (`C = 0`, `K` and `M` symmetric): the generalised problem
+//! `K φ = ω² M φ` by shift and invert, `K + σM = LLᵀ` (Cholesky),
+//! `L⁻¹ M L⁻ᵀ z = μ z`, `ω² = 1/μ − σ`, `φ = L⁻ᵀ z`. The shift makes a singular `K`
+//! (free rigid motions) regular and serves the low modes (their `μ` are the largest and
+//! the most accurate); `μ ≈ 0` are massless directions (infinite frequencies), dropped.
+//! **Damped or gyroscopic**: the first-order form `ż = A z`,
+//! `A = [0 I; −M⁻¹K −M⁻¹C]`, eigenvalues `s = −ζω ± iω√(1−ζ²)` (faer's dense
+//! eigen-decomposition), one mode per conjugate pair.
+//!
+//! Large models would call for shift-invert Lanczos on the project's sparse LU: not built
+//! yet (docs/modes.md).
+
+use faer::Mat;
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+/// A computed mode in reduced coordinates.
+#[derive(Debug, Clone)]
+pub struct RawMode {
+    /// Eigenvalue `s` (real part, imaginary part ≥ 0), 1/s. Conservative: `s = iω`, or
+    /// `s = +√(−ω²)` for a divergent (unstable) direction.
+    pub s: (f64, f64),
+    /// `ω²` of the conservative problem (`|s|²` with the sign of stability otherwise).
+    pub omega2: f64,
+    /// Shape in reduced coordinates (real; for a damped mode the real part of the complex
+    /// shape after turning its largest component real).
+    pub shape: DVector<f64>,
+}
+
+/// Why the dense solve failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DenseError {
+    /// `K + σM` stayed indefinite for every shift tried.
+    #[error(
+        "the stiffness has negative eigenvalues below −{0:.3e} 1/s²: no shift made K + σM positive"
+    )]
+    Indefinite(f64),
+    /// A damped or gyroscopic model with massless directions (the first-order form needs M⁻¹).
+    #[error(
+        "a damped or gyroscopic model with massless degrees of freedom: the first-order form needs a regular mass matrix"
+    )]
+    MasslessDamped,
+    /// The eigen-decomposition did not converge.
+    #[error("the dense eigen-decomposition did not converge")]
+    NoConvergence,
+}
+
+/// A computed zero eigenvalue of the conservative problem lies within round-off of the
+/// assembled stiffness, whose entries carry `ε ‖K‖ ≈ ε ω_max² ‖M‖`: `|ω²| ≤ ZERO_FACTOR ·
+/// ε · ω²_max` is reported as an exact zero (a rigid motion). 10 covers the sums of a few
+/// element contributions per entry; the measured free-free beam's zeros sit at ≈ 0.1–1 ε ω²_max
+/// and the stiffest deck's pendulum mode (decks/pendulum_rigid_hanging.dat) at 1e2 above it.
+pub const ZERO_FACTOR: f64 = 10.0;
+
+/// The reduced symmetric problem's modes, sorted by `ω²` (negative = unstable first).
+pub fn conservative(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<RawMode>, DenseError> {
+    let n = k.nrows();
+    // ω²_max estimate: the largest diagonal ratio (Rayleigh quotients of unit vectors).
+    let mut wmax: f64 = 0.0;
+    for i in 0..n {
+        if m[(i, i)] > 0.0 {
+            wmax = wmax.max(k[(i, i)].abs() / m[(i, i)]);
+        }
+    }
+    let wmax = if wmax > 0.0 { wmax } else { 1.0 };
+    // σ = 1e-8 ω²_max: far above the round-off zeros of K (ε ω²_max), so K + σM is
+    // positive definite, and small enough to cost ω² only ε σ = 1e-8 ε ω²_max.
+    let mut sigma = 1e-8 * wmax;
+    let chol = loop {
+        if let Some(c) = (k + m * sigma).cholesky() {
+            break c;
+        }
+        if sigma > 1e2 * wmax {
+            return Err(DenseError::Indefinite(sigma));
+        }
+        sigma *= 100.0;
+    };
+    let l = chol.l();
+    let linv = l
+        .clone()
+        .solve_lower_triangular(&DMatrix::identity(n, n))
+        .ok_or(DenseError::NoConvergence)?;
+    let a = &linv * m * linv.transpose();
+    let a = (&a + a.transpose()) * 0.5;
+    let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0).ok_or(DenseError::NoConvergence)?;
+    let mu_max = eig.eigenvalues.iter().fold(0.0f64, |x, v| x.max(*v));
+    let mut out = Vec::new();
+    for i in 0..n {
+        let mu = eig.eigenvalues[i];
+        // Massless directions: μ at round-off of the largest.
+        if mu <= (n as f64) * f64::EPSILON * mu_max {
+            continue;
+        }
+        let z = eig.eigenvectors.column(i);
+        // φ = L⁻ᵀ z, normalised to φᵀMφ = 1.
+        let phi = linv.transpose() * z;
+        let phi = &phi / phi.dot(&(m * &phi)).sqrt();
+        // ω² = 1/μ − σ carries ε(ω² + σ)²/σ from μ's absolute error ε/σ: exact enough
+        // below σ; above it the Rayleigh quotient φᵀKφ/φᵀMφ (error quadratic in φ's).
+        let mut omega2 = 1.0 / mu - sigma;
+        if omega2 > sigma {
+            omega2 = phi.dot(&(k * &phi));
+        }
+        out.push(RawMode {
+            s: if omega2 >= 0.0 {
+                (0.0, omega2.sqrt())
+            } else {
+                ((-omega2).sqrt(), 0.0)
+            },
+            omega2,
+            shape: phi,
+        });
+    }
+    out.sort_by(|a, b| a.omega2.total_cmp(&b.omega2));
+    Ok(out)
+}
+
+/// The reduced damped or gyroscopic problem's modes (first-order form), one per conjugate
+/// pair (and one per real eigenvalue), sorted by `|s|`.
+pub fn state_space(
+    k: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+) -> Result<Vec<RawMode>, DenseError> {
+    let n = k.nrows();
+    let chol = m.clone().cholesky().ok_or(DenseError::MasslessDamped)?;
+    let mk = chol.solve(k);
+    let mc = chol.solve(c);
+    let a = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+        (true, true) => 0.0,
+        (true, false) => f64::from(u8::from(j - n == i)),
+        (false, true) => -mk[(i - n, j)],
+        (false, false) => -mc[(i - n, j - n)],
+    });
+    let evd = a.eigen().map_err(|_| DenseError::NoConvergence)?;
+    let s: Vec<_> = evd.S().column_vector().iter().copied().collect();
+    let u = evd.U();
+    let mut out = Vec::new();
+    for i in 0..2 * n {
+        let z = s[i];
+        // One of each conjugate pair; a real eigenvalue is its own mode.
+        if z.im < 0.0 {
+            continue;
+        }
+        // The displacement part, turned so that its largest component is real.
+        let col = |r: usize| u[(r, i)];
+        let (mut best, mut big) = (0, 0.0);
+        for r in 0..n {
+            let v = col(r).re.hypot(col(r).im);
+            if v > big {
+                (best, big) = (r, v);
+            }
+        }
+        let rot = if big > 0.0 {
+            let p = col(best);
+            (p.re / big, -p.im / big)
+        } else {
+            (1.0, 0.0)
+        };
+        let shape = DVector::from_fn(n, |r, _| col(r).re * rot.0 - col(r).im * rot.1);
+        let omega2 = (z.re * z.re + z.im * z.im) * if z.re > 0.0 { -1.0 } else { 1.0 };
+        out.push(RawMode {
+            s: (z.re, z.im),
+            omega2,
+            shape,
+        });
+    }
+    out.sort_by(|a, b| a.omega2.abs().total_cmp(&b.omega2.abs()));
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn free_spring_pair_has_one_zero_and_one_elastic_mode() {
+        // Two unit masses joined by a spring k = 4: ω² = 0 (translation) and 2k/m = 8.
+        let k = DMatrix::from_row_slice(2, 2, &[4.0, -4.0, -4.0, 4.0]);
+        let m = DMatrix::identity(2, 2);
+        let modes = conservative(&k, &m).unwrap();
+        assert_eq!(modes.len(), 2);
+        // ω² = 1/μ − σ (σ = 4e-8) for the zero, within ε σ; the Rayleigh quotient for 8.
+        assert!(modes[0].omega2.abs() < 1e-12, "{}", modes[0].omega2);
+        assert!((modes[1].omega2 - 8.0).abs() < 1e-12, "{}", modes[1].omega2);
+        // Mass-normalised shapes.
+        assert!((modes[1].shape.norm_squared() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn massless_direction_is_dropped() {
+        // Spring to ground k = 1 on a unit mass, plus a massless dof on a spring of 1.
+        let k = DMatrix::from_row_slice(2, 2, &[2.0, -1.0, -1.0, 1.0]);
+        let m = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 0.0]);
+        let modes = conservative(&k, &m).unwrap();
+        // Static condensation: k_eff = 2 − 1 = 1, ω² = 1.
+        assert_eq!(modes.len(), 1);
+        assert!((modes[0].omega2 - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn damped_oscillator_gives_its_damping_ratio() {
+        // m = 2, k = 50, c = 2ζ√(km) with ζ = 0.05: s = −ζω ± iω√(1−ζ²), ω = 5.
+        let (m, k, zeta) = (2.0f64, 50.0f64, 0.05f64);
+        let c = 2.0 * zeta * (k * m).sqrt();
+        let modes = state_space(
+            &DMatrix::from_element(1, 1, k),
+            &DMatrix::from_element(1, 1, c),
+            &DMatrix::from_element(1, 1, m),
+        )
+        .unwrap();
+        assert_eq!(modes.len(), 1);
+        let (re, im) = modes[0].s;
+        let w = (re * re + im * im).sqrt();
+        assert!((w - 5.0).abs() < 1e-12);
+        assert!((-re / w - zeta).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,239 @@
+//! The consistent linearisation of the project's own residual at a state, in dense form.
+//!
+//! Each element's iteration matrix is `S = ∂r/∂q + c_v ∂r/∂v + c_a ∂r/∂a`
+//! ([`crate::elements::EvalContext`]); the part that multiplies `c_v` and `c_a` comes back
+//! separately in [`Local::rate`]. Three evaluations at the state isolate the matrices:
+//! `(c_v, c_a) = (0, 0)` gives the tangent stiffness `K = ∂r/∂q` (material, geometric —
+//! the multipliers' `s Bᵀλ` and the beams' stresses — centrifugal and inertial parts at the
+//! state's velocities and accelerations), `(0, c)` less it `c M` (`M = ∂r/∂a`), `(c, 0)`
+//! less it `c C` (`C = ∂r/∂v`, damping and gyroscopic). A global applied moment adds its follower
+//! stiffness `−(Rᵀm)~` on the node's spin (as [`crate::solver::system::System`] does).
+//! The multiplier rows of `K` hold `s B`, the constraint Jacobian: the free motions are
+//! its null space `q = N y` ([`null_space`]), and the reduced matrices are `NᵀKN`, `NᵀCN`,
+//! `NᵀMN` (Géradin & Cardona, *Flexible Multibody Dynamics*, ch. 12).
+
+use crate::elements::{EvalContext, Local, NodeState};
+use crate::rotation::skew;
+use crate::solver::system::{FIXED, System};
+use nalgebra::{DMatrix, SymmetricEigen};
+
+/// The dense matrices of a linearisation, on the nodal equations of a [`System`].
+#[derive(Debug, Clone)]
+pub struct Linearised {
+    /// Tangent stiffness `∂r/∂q` on the nodal equations.
+    pub k: DMatrix<f64>,
+    /// Damping and gyroscopic matrix `∂r/∂v`.
+    pub c: DMatrix<f64>,
+    /// Mass matrix `∂r/∂a`.
+    pub m: DMatrix<f64>,
+    /// Constraint Jacobian `B` (rows: multiplier equations; columns: nodal equations).
+    pub b: DMatrix<f64>,
+    /// Per element: its local-to-nodal-equation map (`None` = fixed or multiplier) and its
+    /// local stiffness and mass (column-major, size `6·nodes`), for energy shares.
+    pub locals: Vec<ElementMatrices>,
+}
+
+/// One element's local stiffness and mass at the state, with its equation map.
+#[derive(Debug, Clone)]
+pub struct ElementMatrices {
+    /// Nodal equation of each local node dof (`None` = fixed).
+    pub rows: Vec<Option<usize>>,
+    /// Local stiffness `6n × 6n`, column-major.
+    pub k: Vec<f64>,
+    /// Local mass `6n × 6n`, column-major.
+    pub m: Vec<f64>,
+}
+
+impl ElementMatrices {
+    /// `φᵀ A φ` of the local matrix `a` (`k` or `m`) for a nodal-equation vector `phi`.
+    pub fn quadratic(&self, a: &[f64], phi: &[f64]) -> f64 {
+        let n = self.rows.len();
+        let v: Vec<f64> = self
+            .rows
+            .iter()
+            .map(|r| r.map_or(0.0, |i| phi[i]))
+            .collect();
+        let mut s = 0.0;
+        for j in 0..n {
+            if v[j] == 0.0 {
+                continue;
+            }
+            for i in 0..n {
+                s += v[i] * a[j * n + i] * v[j];
+            }
+        }
+        s
+    }
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Assembles `K`, `C`, `M` and `B` at the state (`nodes`, scaled multipliers `lambda`
+/// indexed by global equation, constraint scale `scale`, time `t`).
+pub fn linearise(
+    sys: &System,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+) -> Linearised {
+    let nn = sys.n_node_eq;
+    let n = sys.n_eq();
+    let mut full_k = DMatrix::<f64>::zeros(n, n);
+    let mut c = DMatrix::<f64>::zeros(nn, nn);
+    let mut m = DMatrix::<f64>::zeros(nn, nn);
+    let base = EvalContext {
+        t,
+        c_v: 0.0,
+        c_a: 0.0,
+        dynamic: true,
+        gravity: sys.gravity,
+        constraint_scale: scale,
+        penalty: 0.0,
+        h: 0.0,
+    };
+    let mut locals = Vec::with_capacity(sys.elements.len());
+    for (e, el) in sys.elements.iter().enumerate() {
+        let nm = el.multipliers();
+        let nloc = 6 * el.nodes().len();
+        let size = nloc + nm;
+        let rows: Vec<Option<usize>> = el
+            .nodes()
+            .iter()
+            .flat_map(|&node| sys.node_dofs[node].map(|d| (d != FIXED).then_some(d)))
+            .chain((0..nm).map(|k| Some(sys.mult_offset[e] + k)))
+            .collect();
+        let lam = sys.element_lambda(e, lambda);
+        let eval = |cv: f64, ca: f64| {
+            let mut l = Local::new(size);
+            let ctx = EvalContext {
+                c_v: cv,
+                c_a: ca,
+                ..base
+            };
+            el.evaluate(&ctx, nodes, lam, true, &mut l);
+            l
+        };
+        // K = S(0, 0); M and C as differences S(0, c) − S(0, 0) over c, with c the
+        // ratio of the element's stiffness to its mass (damping) entries, so that the
+        // difference keeps full precision when K ≫ M (stiff bars). (`Local::rate` holds
+        // only the parts the rotation tangent needs: a point mass's translational mass
+        // is in `tan` alone.)
+        let lk = eval(0.0, 0.0);
+        let kmax = max_abs(&lk.tan);
+        let rate_part = |cv: f64, ca: f64| -> Vec<f64> {
+            let probe = eval(cv, ca);
+            let est = probe
+                .tan
+                .iter()
+                .zip(&lk.tan)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let c = if est > 0.0 {
+                (kmax / est).max(1.0)
+            } else {
+                1.0
+            };
+            let l = if c == 1.0 {
+                probe
+            } else {
+                eval(cv * c, ca * c)
+            };
+            l.tan
+                .iter()
+                .zip(&lk.tan)
+                .map(|(a, b)| (a - b) / c)
+                .collect()
+        };
+        let lm = rate_part(0.0, 1.0);
+        let lc = rate_part(1.0, 0.0);
+        let mut ek = vec![0.0; nloc * nloc];
+        let mut em = vec![0.0; nloc * nloc];
+        for j in 0..size {
+            for i in 0..size {
+                let p = j * size + i;
+                let kv = lk.tan[p];
+                if i < nloc && j < nloc {
+                    ek[j * nloc + i] = kv;
+                    em[j * nloc + i] = lm[p];
+                }
+                let (Some(gi), Some(gj)) = (rows[i], rows[j]) else {
+                    continue;
+                };
+                full_k[(gi, gj)] += kv;
+                if gi < nn && gj < nn {
+                    m[(gi, gj)] += lm[p];
+                    c[(gi, gj)] += lc[p];
+                }
+            }
+        }
+        locals.push(ElementMatrices {
+            rows: rows[..nloc].to_vec(),
+            k: ek,
+            m: em,
+        });
+    }
+    // Applied moments: −Rᵀm enters the material equations, its spin derivative −(Rᵀm)~.
+    for l in sys.loads.iter().filter(|l| l.moment) {
+        let mm = nodes[l.node].r.transpose() * l.at(t);
+        let kk = -skew(&mm);
+        let d = &sys.node_dofs[l.node];
+        for a in 0..3 {
+            for b in 0..3 {
+                if d[3 + a] != FIXED && d[3 + b] != FIXED {
+                    full_k[(d[3 + a], d[3 + b])] += kk[(a, b)];
+                }
+            }
+        }
+    }
+    let k = full_k.view((0, 0), (nn, nn)).into_owned();
+    let b = full_k.view((nn, 0), (n - nn, nn)).into_owned() / scale;
+    Linearised { k, c, m, b, locals }
+}
+
+/// Relative threshold on the singular values of the (row-equilibrated) constraint
+/// Jacobian below which a direction is free. Joint Jacobian rows have entries of order 1
+/// (unit vectors) and lever arms; a redundant row is a combination of others to round-off,
+/// `ε·rows`, so its singular value is ~1e-15; squaring (`BᵀB`) leaves ε on `σ²` (~1e-8
+/// on σ): 1e-6 sits between those and any honest constraint.
+const NULL_SPACE_TOL: f64 = 1e-6;
+
+/// An orthonormal basis `N` (columns) of the null space of `b` (`n` columns): the free
+/// motions the constraints allow. Rank-revealing (redundant rows, as a four-bar's
+/// hinges, cost nothing): the eigenvectors of `BᵀB` (rows scaled to unit norm) whose
+/// eigenvalue is below `NULL_SPACE_TOL²` of the largest.
+pub fn null_space(b: &DMatrix<f64>, n: usize) -> DMatrix<f64> {
+    let mut rows = b.clone();
+    for mut r in rows.row_iter_mut() {
+        let norm = r.norm();
+        if norm > 0.0 {
+            r /= norm;
+        }
+    }
+    if rows.nrows() == 0 || rows.iter().all(|v| *v == 0.0) {
+        return DMatrix::identity(n, n);
+    }
+    let btb = rows.transpose() * &rows;
+    let eig = SymmetricEigen::new(btb);
+    let max = eig.eigenvalues.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let keep: Vec<usize> = (0..n)
+        .filter(|&i| eig.eigenvalues[i] <= NULL_SPACE_TOL * NULL_SPACE_TOL * max)
+        .collect();
+    DMatrix::from_fn(n, keep.len(), |r, c| eig.eigenvectors[(r, keep[c])])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn null_space_of_redundant_rows() {
+        // Two equal rows and a third that is their multiple: rank 1 in ℝ³ → 2 free directions.
+        let b = DMatrix::from_row_slice(3, 3, &[1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 2.0, 2.0, 0.0]);
+        let n = null_space(&b, 3);
+        assert_eq!(n.ncols(), 2);
+        assert!((&b * &n).norm() < 1e-14);
+        assert!((n.transpose() * &n - DMatrix::identity(2, 2)).norm() < 1e-14);
+    }
+}

@@ -1,0 +1,280 @@
+//! Linearised modes of a mechanism at a state (`mecano-rs modes DECK`, `ANALYSIS MODES n`).
+//!
+//! [`linearise`] assembles the consistent linearisation of the project's residual —
+//! tangent stiffness with its geometric, inertial and follower-moment parts, damping and
+//! gyroscopic matrix, mass, constraint Jacobian — and eliminates the constraints through
+//! an orthonormal basis `N` of the Jacobian's null space (rank-revealing: redundant joints
+//! cost nothing). [`dense`] solves the reduced problem: the symmetric generalised problem
+//! `NᵀKN φ = ω² NᵀMN φ` when the model is conservative and undamped at the state, else the
+//! quadratic problem in first-order form (frequencies and damping ratios). Rigid motions
+//! come out as exact zeros ([`dense::ZERO_FACTOR`]) and are counted. [`hht`] tells what a
+//! time step resolves of each mode; [`output`] writes `modes.csv`, `modes_shapes.csv`,
+//! `summary.json`; [`cli`] is the `modes` subcommand.
+
+pub mod cli;
+pub mod dense;
+pub mod hht;
+pub mod linearise;
+pub mod output;
+
+use crate::elements::NodeState;
+use crate::solver::system::System;
+use linearise::Linearised;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+/// What a mode is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModeKind {
+    /// A rigid motion (or mechanism motion free of restoring force): zero frequency.
+    Rigid,
+    /// A vibration.
+    Elastic,
+    /// A divergent direction (negative stiffness, or an eigenvalue of positive real part).
+    Unstable,
+}
+
+/// One mode of the linearised model.
+#[derive(Debug, Clone)]
+pub struct Mode {
+    /// Rigid, elastic or unstable.
+    pub kind: ModeKind,
+    /// Damped frequency `Im s / 2π`, Hz (0 for rigid, unstable or overdamped modes).
+    pub frequency_hz: f64,
+    /// Undamped natural frequency `|s| / 2π`, Hz.
+    pub natural_hz: f64,
+    /// Damping ratio `−Re s / |s|` (0 conservative; −1 a pure divergence).
+    pub damping_ratio: f64,
+    /// Eigenvalue `s`, 1/s (real, imaginary parts).
+    pub eigenvalue: (f64, f64),
+    /// Shape on the system's nodal equations (mass-normalised for a conservative model).
+    pub shape: Vec<f64>,
+    /// Share of the mode's kinetic energy `φᵀMφ` per element group ([`ModalAnalysis::groups`]).
+    pub kinetic_share: Vec<f64>,
+    /// Share of its strain energy `φᵀKφ` per element group (0 when the total is not positive).
+    pub strain_share: Vec<f64>,
+}
+
+impl Mode {
+    /// Period `1/f` of the damped frequency, s (`None` when it does not oscillate).
+    pub fn period(&self) -> Option<f64> {
+        (self.frequency_hz > 0.0).then(|| 1.0 / self.frequency_hz)
+    }
+}
+
+/// How the reduced problem was solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Symmetric generalised problem (conservative, undamped).
+    Symmetric,
+    /// Quadratic problem in first-order form (damped, gyroscopic or non-symmetric).
+    StateSpace,
+}
+
+/// The result of a modal analysis.
+#[derive(Debug, Clone)]
+pub struct ModalAnalysis {
+    /// The lowest modes asked for (rigid first, then by frequency).
+    pub modes: Vec<Mode>,
+    /// Unknowns free of constraints (dimension of the Jacobian's null space).
+    pub free_unknowns: usize,
+    /// Constraint equations and their rank.
+    pub constraints: (usize, usize),
+    /// Rigid (zero-frequency) modes in the whole spectrum.
+    pub rigid_modes: usize,
+    /// Finite modes in the whole spectrum (free unknowns less massless directions).
+    pub finite_modes: usize,
+    /// Highest finite frequency of the mesh, Hz.
+    pub highest_hz: f64,
+    /// The solver used.
+    pub method: Method,
+    /// Relative asymmetry `max|K − Kᵀ| / max|K|` of the reduced stiffness.
+    pub asymmetry: f64,
+    /// Element groups (deck keywords) the energy shares refer to.
+    pub groups: Vec<String>,
+}
+
+/// Errors of a modal analysis (bad requests; the CLI exits 2 on them).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModesError {
+    /// No free unknown, or no mass on any: nothing to vibrate.
+    #[error("nothing to vibrate: {0}")]
+    NothingToVibrate(String),
+    /// More modes asked for than the model has.
+    #[error(
+        "{count} modes asked for, but the model has {free} free unknowns ({finite} finite modes)"
+    )]
+    TooMany {
+        /// Modes asked for.
+        count: usize,
+        /// Free unknowns.
+        free: usize,
+        /// Finite modes.
+        finite: usize,
+    },
+    /// The dense solve failed.
+    #[error(transparent)]
+    Dense(#[from] dense::DenseError),
+}
+
+/// Relative size of `C` (against `√(‖K‖‖M‖)`) below which the model is undamped and not
+/// gyroscopic: round-off of assembled zeros is ~ε; 1e-10 keeps a real dashpot or spin.
+const DAMPED_TOL: f64 = 1e-10;
+/// Relative asymmetry of `K` above which the symmetric problem is not used.
+const ASYMMETRY_TOL: f64 = 1e-8;
+
+fn max_abs(a: &DMatrix<f64>) -> f64 {
+    a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
+/// The lowest `count` modes of `sys` linearised at the state (`nodes`, scaled multipliers
+/// `lambda`, constraint scale `scale`, time `t`); `groups[e]` names element `e`'s group.
+pub fn analyse(
+    sys: &System,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+    groups: &[&str],
+    count: usize,
+) -> Result<ModalAnalysis, ModesError> {
+    let lin = linearise::linearise(sys, nodes, lambda, scale, t);
+    let nn = sys.n_node_eq;
+    let basis = linearise::null_space(&lin.b, nn);
+    let free = basis.ncols();
+    if free == 0 {
+        return Err(ModesError::NothingToVibrate(
+            "every degree of freedom is fixed or constrained".into(),
+        ));
+    }
+    if count > free {
+        return Err(ModesError::TooMany {
+            count,
+            free,
+            finite: free,
+        });
+    }
+    let kr = basis.transpose() * &lin.k * &basis;
+    let cr = basis.transpose() * &lin.c * &basis;
+    let mr = basis.transpose() * &lin.m * &basis;
+    if max_abs(&mr) == 0.0 {
+        return Err(ModesError::NothingToVibrate(
+            "no mass on any free degree of freedom".into(),
+        ));
+    }
+    let kn = max_abs(&kr);
+    let asymmetry = if kn > 0.0 {
+        max_abs(&(&kr - kr.transpose())) / kn
+    } else {
+        0.0
+    };
+    let damped = max_abs(&cr) > DAMPED_TOL * (kn.max(f64::MIN_POSITIVE) * max_abs(&mr)).sqrt();
+    let regular_mass = mr.clone().cholesky().is_some();
+    let state_space = (damped || asymmetry > ASYMMETRY_TOL) && regular_mass;
+    let (method, raw) = if state_space {
+        (Method::StateSpace, dense::state_space(&kr, &cr, &mr)?)
+    } else {
+        let ks = (&kr + kr.transpose()) * 0.5;
+        let ms = (&mr + mr.transpose()) * 0.5;
+        (Method::Symmetric, dense::conservative(&ks, &ms)?)
+    };
+    let finite = raw.len();
+    if finite == 0 {
+        return Err(ModesError::NothingToVibrate(
+            "no finite mode: the free directions carry no mass".into(),
+        ));
+    }
+    if count > finite {
+        return Err(ModesError::TooMany {
+            count,
+            free,
+            finite,
+        });
+    }
+    let w2max = raw.iter().fold(0.0f64, |m, r| m.max(r.omega2.abs()));
+    let zero = dense::ZERO_FACTOR * f64::EPSILON * w2max;
+    let is_zero = |r: &dense::RawMode| r.omega2.abs() <= zero;
+    let rigid_modes = raw.iter().filter(|r| is_zero(r)).count();
+    let highest_hz = w2max.sqrt() / (2.0 * PI);
+    // Rigid first, unstable next, then by ω².
+    let mut order: Vec<&dense::RawMode> = raw.iter().collect();
+    order.sort_by_key(|r| u8::from(!is_zero(r)));
+    let mut group_names: Vec<String> = Vec::new();
+    let group_of: Vec<usize> = groups
+        .iter()
+        .map(|g| match group_names.iter().position(|n| n == g) {
+            Some(i) => i,
+            None => {
+                group_names.push(g.to_string());
+                group_names.len() - 1
+            }
+        })
+        .collect();
+    let modes = order
+        .into_iter()
+        .take(count)
+        .map(|r| make_mode(r, is_zero(r), &basis, &lin, &group_of, group_names.len()))
+        .collect();
+    Ok(ModalAnalysis {
+        modes,
+        free_unknowns: free,
+        constraints: (lin.b.nrows(), nn - free),
+        rigid_modes,
+        finite_modes: finite,
+        highest_hz,
+        method,
+        asymmetry,
+        groups: group_names,
+    })
+}
+
+fn make_mode(
+    r: &dense::RawMode,
+    zero: bool,
+    basis: &DMatrix<f64>,
+    lin: &Linearised,
+    group_of: &[usize],
+    ngroups: usize,
+) -> Mode {
+    let phi: DVector<f64> = basis * &r.shape;
+    let shape: Vec<f64> = phi.iter().copied().collect();
+    let (mut kin, mut strain) = (vec![0.0; ngroups], vec![0.0; ngroups]);
+    for (e, el) in lin.locals.iter().enumerate() {
+        let g = group_of.get(e).copied().unwrap_or(0);
+        if g < ngroups {
+            kin[g] += el.quadratic(&el.m, &shape);
+            strain[g] += el.quadratic(&el.k, &shape);
+        }
+    }
+    let share = |v: &mut Vec<f64>| {
+        let tot: f64 = v.iter().sum();
+        if tot > 0.0 {
+            v.iter_mut().for_each(|x| *x /= tot);
+        } else {
+            v.iter_mut().for_each(|x| *x = 0.0);
+        }
+    };
+    share(&mut kin);
+    share(&mut strain);
+    let (re, im) = if zero { (0.0, 0.0) } else { r.s };
+    let w = re.hypot(im);
+    let kind = if zero {
+        ModeKind::Rigid
+    } else if re > 0.0 {
+        ModeKind::Unstable
+    } else {
+        ModeKind::Elastic
+    };
+    Mode {
+        kind,
+        frequency_hz: im / (2.0 * PI),
+        natural_hz: w / (2.0 * PI),
+        damping_ratio: if w > 0.0 { -re / w } else { 0.0 },
+        eigenvalue: (re, im),
+        shape,
+        kinetic_share: kin,
+        strain_share: strain,
+    }
+}
