@@ -244,6 +244,17 @@ impl Table {
             file: file.to_path_buf(),
             msg,
         };
+        // A run written with OUTPUT FORMAT NETCDF: the same history from histories.nc.
+        if !file.is_file()
+            && let Some(t) = crate::output::read::from_columnar(file)
+        {
+            let t = t.map_err(|e| err(e.to_string()))?;
+            return Ok(Table {
+                file: file.to_path_buf(),
+                columns: t.columns,
+                rows: t.rows,
+            });
+        }
         let mut rdr = csv::Reader::from_path(file).map_err(|e| err(e.to_string()))?;
         let columns: Vec<String> = rdr
             .headers()
@@ -289,7 +300,7 @@ pub fn read_node(dir: &Path, node: u32) -> Result<Table, PlotError> {
         return Err(PlotError::NoDir(dir.to_path_buf()));
     }
     let file = dir.join(format!("node_{node}.csv"));
-    if !file.is_file() {
+    if !file.is_file() && !crate::output::read::holds(&file) {
         return Err(PlotError::NoFile {
             file,
             hint: format!(

@@ -110,6 +110,16 @@ pub fn read_history(path: &Path) -> Result<History, CompareError> {
         path: path.to_path_buf(),
         why,
     };
+    // A run written with OUTPUT FORMAT NETCDF: the same history from histories.nc.
+    if !path.is_file()
+        && let Some(t) = crate::output::read::from_columnar(path)
+    {
+        let t = t.map_err(|e| err(e.to_string()))?;
+        return Ok(History {
+            header: t.columns,
+            rows: t.rows,
+        });
+    }
     let mut r = csv::ReaderBuilder::new()
         .has_headers(true)
         .from_path(path)
@@ -408,6 +418,10 @@ fn histories(dir: &Path) -> Result<BTreeMap<(String, u32), String>, CompareError
                 out.insert((kind.to_string(), n), name.clone());
             }
         }
+    }
+    for (kind, n) in crate::output::read::entities(dir) {
+        out.entry((kind.clone(), n))
+            .or_insert_with(|| format!("{kind}_{n}.csv"));
     }
     Ok(out)
 }
