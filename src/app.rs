@@ -257,8 +257,8 @@ fn free_bytes(dir: &Path) -> Option<f64> {
     let c = std::ffi::CString::new(d.as_os_str().as_encoded_bytes()).ok()?;
     let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
     // SAFETY: `c` is a NUL-terminated path and `s` a writable statvfs.
-    (unsafe { libc::statvfs(c.as_ptr(), &mut s) } == 0)
-        .then(|| s.f_bavail as f64 * s.f_frsize as f64)
+    let ok = unsafe { libc::statvfs(c.as_ptr(), &mut s) } == 0;
+    ok.then_some(s.f_bavail as f64 * s.f_frsize as f64)
 }
 
 /// The default output directory of a deck: the deck's `OUTPUT DIR` or `out/<deck stem>`.

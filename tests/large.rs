@@ -178,6 +178,14 @@ fn netcdf_holds_the_csv_numbers_and_compare_plot_and_resume_read_it() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
 
+    // sweep's quantities of interest read a history through plot's Table.
+    let from_nc = mecano::plot::Table::read(&nc.join("node_2.csv")).unwrap();
+    let from_csv = mecano::plot::Table::read(&csv.join("node_2.csv")).unwrap();
+    assert_eq!(
+        from_nc.column("uy").unwrap(),
+        from_csv.column("uy").unwrap()
+    );
+
     // Stopped by SIGINT at step 13 and resumed: histories.nc byte for byte as the run
     // never stopped (the file is cut back to its checkpoint, its record count with it).
     let stopped = d.join("stopped");
