@@ -190,6 +190,7 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
                 integ.sys.n_eq() - integ.sys.n_node_eq,
                 integ.sys.matrix.nnz()
             );
+            check_output(&mut out, path, &model, &integ.sys);
             // The mesh's highest frequency and what the step resolves (issue 24).
             crate::modes::cli::check_report(&model, &mut out);
             EXIT_OK
@@ -199,6 +200,67 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
             EXIT_BAD_INPUT
         }
     }
+}
+
+/// `--check`'s lines on what the OUTPUT selection writes, and a warning when a second of
+/// simulated time (or the whole run) would write more than the output disk holds.
+fn check_output(out: &mut impl Write, path: &Path, model: &Model, sys: &solver::System) {
+    let v = crate::output::volume(model, sys);
+    let _ = writeln!(
+        out,
+        "output:      {} files, {} per written instant, {:.0} instants and {} per second of simulated time, {} for the run",
+        v.files,
+        bytes(v.bytes_per_row),
+        v.rows_per_second,
+        bytes(v.bytes_per_row * v.rows_per_second),
+        bytes(v.total_bytes)
+    );
+    let dir = default_out_dir(path, model);
+    if let Some(free) = free_bytes(&dir) {
+        let per_second = v.bytes_per_row * v.rows_per_second;
+        if per_second > free || v.total_bytes > free {
+            eprintln!(
+                "warning: {}: the OUTPUT selection writes {} per simulated second ({} for the run), more than the {} free on the disk of {}; select fewer nodes and elements, EVERY n, or FORMAT NETCDF",
+                path.display(),
+                bytes(per_second),
+                bytes(v.total_bytes),
+                bytes(free),
+                dir.display()
+            );
+        }
+    }
+}
+
+/// A byte count in B, kB, MB, GB (powers of 1000).
+fn bytes(b: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB"];
+    let mut x = b;
+    let mut u = 0;
+    while x >= 1000.0 && u + 1 < units.len() {
+        x /= 1000.0;
+        u += 1;
+    }
+    format!("{x:.3} {}", units[u])
+}
+
+/// Free bytes on the file system that holds `dir` (or its nearest existing parent).
+fn free_bytes(dir: &Path) -> Option<f64> {
+    let mut d = dir.to_path_buf();
+    while !d.exists() {
+        d = d
+            .parent()
+            .map(Path::to_path_buf)
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or_else(|| PathBuf::from("."));
+        if d == Path::new(".") {
+            break;
+        }
+    }
+    let c = std::ffi::CString::new(d.as_os_str().as_encoded_bytes()).ok()?;
+    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
+    // SAFETY: `c` is a NUL-terminated path and `s` a writable statvfs.
+    let ok = unsafe { libc::statvfs(c.as_ptr(), &mut s) } == 0;
+    ok.then_some(s.f_bavail as f64 * s.f_frsize as f64)
 }
 
 /// The default output directory of a deck: the deck's `OUTPUT DIR` or `out/<deck stem>`.
@@ -263,7 +325,14 @@ fn start_session(
 ) -> Result<RunReport, (u8, String)> {
     let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
     let io_err = |e: std::io::Error| (EXIT_FAILED, format!("{}: {e}", dir.display()));
-    let mut writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(io_err)?;
+    // Output that cannot be opened stops the run before its first step, as bad input
+    // does (issue 29: exit 2, the cause named; nothing is computed for nowhere).
+    let mut writer = Writer::create(dir, deck_name, model, &integ.sys).map_err(|e| {
+        (
+            EXIT_BAD_INPUT,
+            format!("cannot open the output in {}: {e}", dir.display()),
+        )
+    })?;
     writer.refine = plan.as_ref().map_or(1, |p| p.deck.refine);
     if every_step {
         writer.every_accepted_step();

@@ -220,6 +220,7 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
         match s {
             Selection::All => Selection::All,
             Selection::None => Selection::None,
+            Selection::Default => Selection::Default,
             Selection::List(v) => Selection::List(v.iter().map(f).collect()),
         }
     }

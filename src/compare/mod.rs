@@ -134,6 +134,10 @@ fn histories(dir: &Path) -> Result<BTreeMap<(String, u32), String>, CompareError
             }
         }
     }
+    for (kind, n) in crate::output::columnar::entities(dir) {
+        out.entry((kind.clone(), n))
+            .or_insert_with(|| format!("{kind}_{n}.csv"));
+    }
     Ok(out)
 }
 

@@ -359,6 +359,21 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "output directory (the command line's -o wins)",
     ),
     kw("VTK", "OUTPUT", "also write a ParaView series of VTK files"),
+    kw(
+        "FORMAT",
+        "OUTPUT",
+        "CSV (default: node_<N>.csv, element_<N>.csv) or NETCDF (one histories.nc)",
+    ),
+    kw(
+        "CSV",
+        "OUTPUT",
+        "FORMAT CSV: one CSV file per node and element",
+    ),
+    kw(
+        "NETCDF",
+        "OUTPUT",
+        "FORMAT NETCDF: every history in one NetCDF file, histories.nc",
+    ),
 ];
 
 /// In debug builds, checks that the parser only matches keywords listed in [`KEYWORDS`].

@@ -61,6 +61,7 @@ fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
     match s {
         Selection::All => "ALL".into(),
         Selection::None => "NONE".into(),
+        Selection::Default => String::new(),
         Selection::List(v) => {
             let n: Vec<String> = v.iter().map(|x| num(x).to_string()).collect();
             n.join(" ")
@@ -309,18 +310,23 @@ pub fn write_deck(model: &Model) -> String {
         }
     }
     let o = &model.output;
-    let _ = write!(
-        s,
-        "OUTPUT NODES {} ELEMENTS {} EVERY {}",
-        selection(&o.nodes, |n| n.0),
-        selection(&o.elements, |e| e.0),
-        o.every
-    );
+    s.push_str("OUTPUT");
+    // The default selection is written as no field (parsing gives it back).
+    if o.nodes != Selection::Default {
+        let _ = write!(s, " NODES {}", selection(&o.nodes, |n| n.0));
+    }
+    if o.elements != Selection::Default {
+        let _ = write!(s, " ELEMENTS {}", selection(&o.elements, |e| e.0));
+    }
+    let _ = write!(s, " EVERY {}", o.every);
     if let Some(d) = &o.dir {
         let _ = write!(s, " DIR {d}");
     }
     if o.vtk {
         s.push_str(" VTK");
+    }
+    if o.netcdf {
+        s.push_str(" FORMAT NETCDF");
     }
     s.push_str("\nEND\n");
     s

@@ -9,7 +9,7 @@
 use super::output::{self, DeckStep};
 use super::{ModalAnalysis, ModesError};
 use crate::app::{self, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK};
-use crate::model::{Analysis, Model, Selection};
+use crate::model::{Analysis, Model};
 use crate::solver::{self, Integrator, Observer, Snapshot};
 use clap::Args;
 use std::io::Write as _;
@@ -250,14 +250,7 @@ fn out_dir(args: &ModesArgs, model: &Model) -> PathBuf {
 }
 
 fn shape_nodes(model: &Model) -> Vec<usize> {
-    match &model.output.nodes {
-        Selection::All => (0..model.nodes.len()).collect(),
-        Selection::List(ids) => ids
-            .iter()
-            .filter_map(|id| model.nodes.get_index_of(id))
-            .collect(),
-        Selection::None => Vec::new(),
-    }
+    model.output_node_indices()
 }
 
 /// Loads the deck with its overrides (`--set`, `--refine`, `--order`).

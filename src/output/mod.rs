@@ -19,13 +19,19 @@
 //! error. `summary.json` reports its largest positive value relative to
 //! `max(|E(0)|, W_ext, the largest of T, U over the run)`.
 
+pub mod columnar;
+pub mod netcdf;
+mod plan;
 pub mod read;
 mod stream;
 pub mod vtk;
 
-use crate::model::{Model, Selection};
+use crate::model::Model;
 use crate::rotation;
 use crate::solver::{Failure, Interruption, Observer, RunReport, Snapshot, Stats, System};
+use netcdf::Columnar;
+pub use plan::{CSV_NUMBER_BYTES, Volume, volume};
+use plan::{groups, plan};
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -86,6 +92,9 @@ pub struct Writer {
     nodes: Vec<(usize, Stream)>,
     elements: Vec<(usize, Stream)>,
     energy: Stream,
+    /// `histories.nc` (`OUTPUT FORMAT NETCDF`), with its nodes and elements (dense
+    /// indices, elements in the order of its groups) in place of the CSVs.
+    columnar: Option<(Columnar, Vec<usize>, Vec<usize>)>,
     e0: Option<f64>,
     energy_scale: f64,
     max_balance: f64,
@@ -119,63 +128,32 @@ pub struct WriterState {
     sampling: Option<Sampling>,
 }
 
-/// The files a model's OUTPUT asks for: (dense node, file, header), (dense element,
-/// file, header).
-type Plan = (Vec<(usize, PathBuf)>, Vec<(usize, PathBuf, String)>);
-
-fn plan(dir: &Path, model: &Model, sys: &System) -> Plan {
-    let node_idx: Vec<usize> = match &model.output.nodes {
-        Selection::All => (0..model.nodes.len()).collect(),
-        Selection::None => Vec::new(),
-        Selection::List(l) => l
-            .iter()
-            .filter_map(|id| model.nodes.get_index_of(id))
-            .collect(),
-    };
-    let nodes = node_idx
-        .into_iter()
-        .map(|i| (i, dir.join(format!("node_{}.csv", sys.node_ids[i].0))))
-        .collect();
-    let elem_idx: Vec<usize> = match &model.output.elements {
-        Selection::All => (0..model.elements.len()).collect(),
-        Selection::None => Vec::new(),
-        Selection::List(l) => l
-            .iter()
-            .filter_map(|id| model.elements.get_index_of(id))
-            .collect(),
-    };
-    let mut elements = Vec::new();
-    for e in elem_idx {
-        let el = &sys.elements[e];
-        let header = el.output_header();
-        if header.is_empty() {
-            continue;
-        }
-        elements.push((
-            e,
-            dir.join(format!("element_{}.csv", el.id().0)),
-            format!("t,{}", header.join(",")),
-        ));
-    }
-    (nodes, elements)
-}
-
 impl Writer {
     /// Creates the output directory, the files the model's OUTPUT requests, and a
     /// `summary.json` that says `"complete": false` until [`Writer::finish`] says otherwise.
     pub fn create(dir: &Path, deck: &str, model: &Model, sys: &System) -> io::Result<Self> {
         fs::create_dir_all(dir)?;
-        let (node_files, elem_files) = plan(dir, model, sys);
+        let mut p = plan(dir, model, sys);
+        let columnar = if model.output.netcdf {
+            let (g, n, e) = groups(&p, sys);
+            p = (Vec::new(), Vec::new());
+            Some((Columnar::create(dir, &model.title, &g)?, n, e))
+        } else {
+            None
+        };
+        let (node_files, elem_files) = p;
+        let block = stream::block_size(node_files.len() + elem_files.len() + 1);
         let mut nodes = Vec::new();
         for (i, path) in node_files {
-            nodes.push((i, Stream::create(&path, NODE_HEADER)?));
+            nodes.push((i, Stream::create(&path, NODE_HEADER, block)?));
         }
         let mut elements = Vec::new();
         for (e, path, head) in elem_files {
-            elements.push((e, Stream::create(&path, &head)?));
+            elements.push((e, Stream::create(&path, &head, block)?));
         }
-        let energy = Stream::create(&dir.join("energy.csv"), ENERGY_HEADER)?;
-        let w = Self::with_streams(dir, deck, model, nodes, elements, energy);
+        let energy = Stream::create(&dir.join("energy.csv"), ENERGY_HEADER, block)?;
+        let mut w = Self::with_streams(dir, deck, model, nodes, elements, energy);
+        w.columnar = columnar;
         w.write_summary(None, None)?;
         Ok(w)
     }
@@ -190,7 +168,24 @@ impl Writer {
         sys: &System,
         state: &WriterState,
     ) -> io::Result<Self> {
-        let (node_files, elem_files) = plan(dir, model, sys);
+        let mut p = plan(dir, model, sys);
+        let mut columnar = None;
+        if model.output.netcdf {
+            let (g, n, e) = groups(&p, sys);
+            p = (Vec::new(), Vec::new());
+            let len = match state.files.last() {
+                Some((name, len)) if name == netcdf::FILE_NAME => *len,
+                _ => {
+                    return Err(io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        format!("the checkpoint has no {}", netcdf::FILE_NAME),
+                    ));
+                }
+            };
+            columnar = Some((Columnar::reopen(dir, &model.title, &g, len)?, n, e));
+        }
+        let files = &state.files[..state.files.len() - usize::from(columnar.is_some())];
+        let (node_files, elem_files) = p;
         let mut names: Vec<(PathBuf, String)> = node_files
             .iter()
             .map(|(_, p)| (p.clone(), NODE_HEADER.to_string()))
@@ -198,7 +193,7 @@ impl Writer {
         names.extend(elem_files.iter().map(|(_, p, h)| (p.clone(), h.clone())));
         names.push((dir.join("energy.csv"), ENERGY_HEADER.to_string()));
         let expected: Vec<String> = names.iter().map(|(p, _)| stream::file_name(p)).collect();
-        let saved: Vec<String> = state.files.iter().map(|(n, _)| n.clone()).collect();
+        let saved: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
         if expected != saved {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
@@ -210,8 +205,9 @@ impl Writer {
             ));
         }
         let mut streams = Vec::with_capacity(names.len());
-        for ((path, header), (_, len)) in names.iter().zip(&state.files) {
-            streams.push(Stream::reopen(path, header, *len)?);
+        let block = stream::block_size(names.len());
+        for ((path, header), (_, len)) in names.iter().zip(files) {
+            streams.push(Stream::reopen(path, header, *len, block)?);
         }
         let energy = streams.pop().expect("energy.csv is always written");
         let elements: Vec<(usize, Stream)> = elem_files
@@ -221,6 +217,7 @@ impl Writer {
             .collect();
         let nodes: Vec<(usize, Stream)> = node_files.iter().map(|(i, _)| *i).zip(streams).collect();
         let mut w = Self::with_streams(dir, deck, model, nodes, elements, energy);
+        w.columnar = columnar;
         w.e0 = state.e0;
         w.energy_scale = state.energy_scale;
         w.max_balance = state.max_balance;
@@ -255,6 +252,7 @@ impl Writer {
             nodes,
             elements,
             energy,
+            columnar: None,
             e0: None,
             energy_scale: 0.0,
             max_balance: 0.0,
@@ -276,6 +274,10 @@ impl Writer {
         }
         self.energy.sync()?;
         files.push((self.energy.name.clone(), self.energy.len()));
+        if let Some((c, _, _)) = &mut self.columnar {
+            c.sync()?;
+            files.push((netcdf::FILE_NAME.to_string(), c.len()));
+        }
         Ok(WriterState {
             files,
             e0: self.e0,
@@ -310,26 +312,32 @@ impl Writer {
         let integ = snap.integ;
         let t = integ.t;
         for (i, st) in &mut self.nodes {
-            let s = &integ.nodes[*i];
-            let x0 = integ.sys.x0[*i];
-            let u = s.x - x0;
-            let phi = rotation::log(&s.r);
-            let w = s.r * s.w;
-            let row = [
-                t, s.x.x, s.x.y, s.x.z, u.x, u.y, u.z, phi.x, phi.y, phi.z, s.v.x, s.v.y, s.v.z,
-                w.x, w.y, w.z, s.a.x, s.a.y, s.a.z,
-            ];
-            st.row(&row)?;
+            st.row(&node_row(integ, *i))?;
         }
         let ctx = integ.current_context();
-        for (e, st) in &mut self.elements {
-            let el = &integ.sys.elements[*e];
-            let lam = integ.sys.element_lambda(*e, &integ.lambda);
-            let row = &mut self.row;
+        let element_row = |e: usize, row: &mut Vec<f64>| {
+            let el = &integ.sys.elements[e];
+            let lam = integ.sys.element_lambda(e, &integ.lambda);
             row.clear();
             row.push(t);
             el.write_output_row(&ctx, &integ.nodes, lam, row);
-            st.row(row)?;
+        };
+        for (e, st) in &mut self.elements {
+            element_row(*e, &mut self.row);
+            st.row(&self.row)?;
+        }
+        if let Some((c, nodes, elements)) = &mut self.columnar {
+            c.begin(t);
+            for i in nodes.iter() {
+                let row = node_row(integ, *i);
+                finite(&row, "histories.nc (node)")?;
+                c.put(&row[1..]);
+            }
+            for e in elements.iter() {
+                element_row(*e, &mut self.row);
+                finite(&self.row, "histories.nc (element)")?;
+                c.put(&self.row[1..]);
+            }
         }
         let e = integ.energies();
         let total = e.kinetic + e.strain + e.gravity;
@@ -345,7 +353,7 @@ impl Writer {
         if integ.dynamic && self.energy_scale > 0.0 {
             self.max_balance = self.max_balance.max(residual / self.energy_scale);
         }
-        self.energy.row(&[
+        let row = [
             t,
             e.kinetic,
             e.strain,
@@ -355,7 +363,12 @@ impl Writer {
             integ.damping_work,
             numerical,
             residual,
-        ])?;
+        ];
+        self.energy.row(&row)?;
+        if let Some((c, _, _)) = &mut self.columnar {
+            c.put(&row[1..]);
+            c.end()?;
+        }
         self.last_row = Some(snap.step);
         Ok(())
     }
@@ -364,6 +377,9 @@ impl Writer {
     pub fn flush(&mut self) -> io::Result<()> {
         for (_, s) in self.nodes.iter_mut().chain(self.elements.iter_mut()) {
             s.flush()?;
+        }
+        if let Some((c, _, _)) = &mut self.columnar {
+            c.flush()?;
         }
         self.energy.flush()
     }
@@ -451,6 +467,33 @@ impl Writer {
     /// Largest relative energy-balance error so far.
     pub fn max_balance_error(&self) -> f64 {
         self.max_balance
+    }
+}
+
+/// A node's row of `node_<N>.csv` ([`NODE_HEADER`]).
+fn node_row(integ: &crate::solver::Integrator, i: usize) -> [f64; 19] {
+    let s = &integ.nodes[i];
+    let u = s.x - integ.sys.x0[i];
+    let phi = rotation::log(&s.r);
+    let w = s.r * s.w;
+    [
+        integ.t, s.x.x, s.x.y, s.x.z, u.x, u.y, u.z, phi.x, phi.y, phi.z, s.v.x, s.v.y, s.v.z, w.x,
+        w.y, w.z, s.a.x, s.a.y, s.a.z,
+    ]
+}
+
+/// Refuses a row with a non-finite value (no NaN reaches a file).
+fn finite(row: &[f64], file: &str) -> io::Result<()> {
+    match row.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(bad) => Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "refusing to write a non-finite value to {file} (column {}, t = {})",
+                bad + 1,
+                row[0]
+            ),
+        )),
     }
 }
 

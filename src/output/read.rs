@@ -1,7 +1,9 @@
 //! The one reader of the numeric CSV files a run writes (`node_<N>.csv`,
 //! `element_<N>.csv`, `energy.csv`): a header row of column names, then rows of numbers.
 //! Used by `plot` (and through it `sweep`'s quantities) and by `compare`; each wraps the
-//! message of a failure in its own error type.
+//! message of a failure in its own error type. A history asked for by its CSV's name in a
+//! run written with `OUTPUT … FORMAT NETCDF` comes from `histories.nc` instead
+//! ([`super::columnar`]), so every reader sees the two formats alike.
 
 use std::path::Path;
 
@@ -26,6 +28,16 @@ pub struct ReadOptions<'a> {
 /// Reads `path`: the error is a message (the CSV parser's, or `row R: …` with `R` the
 /// line of the file, header = line 1).
 pub fn read_numeric(path: &Path, opt: ReadOptions) -> Result<NumericCsv, String> {
+    // A run written with OUTPUT FORMAT NETCDF: the same history from histories.nc.
+    if !path.is_file()
+        && let Some(t) = super::columnar::from_columnar(path)
+    {
+        let t = t.map_err(|e| e.to_string())?;
+        return Ok(NumericCsv {
+            header: t.columns,
+            rows: t.rows,
+        });
+    }
     let trim = |s: &str| if opt.trim { s.trim() } else { s }.to_string();
     let mut r = csv::ReaderBuilder::new()
         .has_headers(true)

@@ -62,7 +62,7 @@ pub fn read_node(dir: &Path, node: u32) -> Result<Table, PlotError> {
         return Err(PlotError::NoDir(dir.to_path_buf()));
     }
     let file = dir.join(format!("node_{node}.csv"));
-    if !file.is_file() {
+    if !file.is_file() && !crate::output::columnar::holds(&file) {
         return Err(PlotError::NoFile {
             file,
             hint: format!(

@@ -249,7 +249,7 @@ impl Builder<'_> {
         let span = card.span();
         let mut c = Cursor::new(card, "OUTPUT card");
         c.skip();
-        const KW: [&str; 5] = ["NODES", "ELEMENTS", "EVERY", "DIR", "VTK"];
+        const KW: [&str; 6] = ["NODES", "ELEMENTS", "EVERY", "DIR", "VTK", "FORMAT"];
         let mut seen = Seen::default();
         let mut out = OutputRequest::default();
         while let Some(t) = c.peek() {
@@ -306,6 +306,7 @@ impl Builder<'_> {
                         Selection::All => out.elements = Selection::All,
                         Selection::None if kw == "NODES" => out.nodes = Selection::None,
                         Selection::None => out.elements = Selection::None,
+                        Selection::Default => {}
                     }
                 }
                 "EVERY" => {
@@ -316,6 +317,16 @@ impl Builder<'_> {
                     out.every = n;
                 }
                 "DIR" => out.dir = Some(c.next("directory after DIR")?.text.to_string()),
+                "FORMAT" => match c.keyword(&["CSV", "NETCDF"]) {
+                    Some((f, _)) => out.netcdf = f == "NETCDF",
+                    None => {
+                        let e = "CSV or NETCDF after FORMAT";
+                        return Err(match c.peek() {
+                            Some(t) => c.unexpected(t, e),
+                            None => c.missing(e),
+                        });
+                    }
+                },
                 _ => out.vtk = true,
             }
         }
