@@ -29,7 +29,11 @@ END
 ",
         last = elements + 1,
         dx = 1.0 / elements as f64,
-        ord = if order > 1 { format!(" ORDER {order}") } else { String::new() },
+        ord = if order > 1 {
+            format!(" ORDER {order}")
+        } else {
+            String::new()
+        },
     );
     parse_deck(&text, "damped cantilever").expect("the deck parses")
 }
@@ -88,7 +92,10 @@ fn decay(h: &History, tip: usize, skip: usize) -> (f64, f64) {
     let periods = halves / 2.0;
     let delta = (amp[0] / amp[amp.len() - 1]).ln() / periods;
     let td = (ex[ex.len() - 1].0 - ex[0].0) / ((ex.len() - 1) as f64 / 2.0);
-    (delta / (4.0 * PI * PI + delta * delta).sqrt(), 2.0 * PI / td)
+    (
+        delta / (4.0 * PI * PI + delta * delta).sqrt(),
+        2.0 * PI / td,
+    )
 }
 
 /// A cantilever of 20 two-node beams with η = 2ζ/ω₁ for ζ = 1 %: the tip's logarithmic
@@ -122,7 +129,11 @@ fn cantilever_first_mode_decays_with_zeta_eta_omega_over_two() {
         z / (eta * w1 / 2.0) - 1.0,
         z / (eta * w / 2.0) - 1.0
     );
-    assert!((z / (eta * w1 / 2.0) - 1.0).abs() < 5e-3, "zeta {z} vs {}", eta * w1 / 2.0);
+    assert!(
+        (z / (eta * w1 / 2.0) - 1.0).abs() < 5e-3,
+        "zeta {z} vs {}",
+        eta * w1 / 2.0
+    );
     // Energy balance: E(t) − E(0) = −W_d + (numerical), with the numerical part of the
     // trapezoidal rule O((ωh)²) of the dissipated work (the power is integrated by the
     // trapezoid, the equations by the midpoint of the velocities: they differ by
@@ -136,7 +147,10 @@ fn cantilever_first_mode_decays_with_zeta_eta_omega_over_two() {
         numerical / wd_total
     );
     assert!(wd_total > 0.0);
-    assert!(numerical.abs() < 1e-3 * wd_total, "balance residue {numerical:e} J");
+    assert!(
+        numerical.abs() < 1e-3 * wd_total,
+        "balance residue {numerical:e} J"
+    );
 }
 
 /// The same with two elements of order 6 (the order-p beam): the same ζ, same tolerance

@@ -147,7 +147,8 @@ fn the_examples_run() {
         );
         let last = h.nodes.last().expect("states recorded");
         assert!(
-            last.iter().all(|s| s.x.iter().chain(s.r.iter()).all(|v| v.is_finite())),
+            last.iter()
+                .all(|s| s.x.iter().chain(s.r.iter()).all(|v| v.is_finite())),
             "example {k}: non-finite state"
         );
     }

@@ -55,11 +55,7 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
     let mut unsupported = Vec::new();
     for el in model.elements.values() {
         match &el.kind {
-            ElementKind::Beam {
-                section,
-                order,
-                ..
-            } => {
+            ElementKind::Beam { section, order, .. } => {
                 let sec = &model.sections[section];
                 let nodes: Vec<usize> = el.nodes.iter().map(idx).collect();
                 if *order as usize > beam_p::MAX_ORDER

@@ -72,12 +72,7 @@ impl BeamP {
     /// Damping forces (node by node `[f_x, f_Θ]` into `f`, `2n` entries) and the dissipated
     /// power, generic in the scalar; `shift` are the log branch shifts of the nodes'
     /// relative rotations at the (f64) state.
-    fn damping_forces<S: Real>(
-        &self,
-        s: &States<S>,
-        shift: &[f64],
-        f: &mut [Vector3<S>],
-    ) -> S {
+    fn damping_forces<S: Real>(&self, s: &States<S>, shift: &[f64], f: &mut [Vector3<S>]) -> S {
         let n = s.x.len();
         let m = self.refn;
         let l0: Vec<Matrix3<S>> = self.lambda0.iter().map(|l| l.map(c)).collect();
@@ -211,11 +206,7 @@ impl BeamP {
                 w: s.w.iter().map(lift3).collect(),
             };
             let seed = |v: &Vector3<f64>, k: usize| {
-                Vector3::new(
-                    D12::var(v.x, k),
-                    D12::var(v.y, k + 1),
-                    D12::var(v.z, k + 2),
-                )
+                Vector3::new(D12::var(v.x, k), D12::var(v.y, k + 1), D12::var(v.z, k + 2))
             };
             // R (I + δΘ̃): the right-multiplied rotation variation, to first order.
             let dth = seed(&Vector3::zeros(), 3);
@@ -240,41 +231,15 @@ impl BeamP {
 mod tests {
     use super::*;
     use crate::elements::Element;
-    use crate::elements::beam::{default_axis2, reference_triad};
+    use crate::elements::beam_p::tests::straight;
     use crate::elements::testing::*;
-    use crate::lagrange;
-    use crate::model::ElementId;
-
-    fn steel() -> crate::elements::beam::BeamProperties {
-        let (e, g, a, i, j, rho) = (2.1e11, 2.1e11 / 2.6, 9e-4, 8.3e-8, 4.15e-8, 7800.0);
-        crate::elements::beam::BeamProperties {
-            cn: Vector3::new(e * a, 5.0 / 6.0 * g * a, 5.0 / 6.0 * g * a),
-            cm: Vector3::new(g * j, e * i, e * i),
-            mass: rho * a,
-            inertia: Vector3::new(rho * 2.0 * i, rho * i, rho * i),
-        }
-    }
 
     /// A damped straight beam of order `p` (η = 1e-4 s: c_v η = 0.2, the damping part is a
     /// fifth of the stiffness in the iteration matrix) and its reference positions.
     fn damped(p: usize) -> (BeamP, Vec<Vector3<f64>>) {
         let (x1, x2) = (Vector3::new(0.1, 0.2, -0.1), Vector3::new(0.4, 0.25, 0.05));
-        let (xi, _) = lagrange::gll(p);
-        let x0: Vec<_> = xi
-            .iter()
-            .map(|t| x1 + (x2 - x1) * (0.5 * (1.0 + t)))
-            .collect();
-        let triad = reference_triad(&x1, &x2, &default_axis2(&(x2 - x1)));
-        let b = BeamP::new(
-            ElementId(1),
-            (0..=p).collect(),
-            &xi,
-            &x0,
-            &vec![triad; p + 1],
-            steel(),
-        )
-        .with_damping(1e-4);
-        (b, x0)
+        let (b, x0) = straight(p, x1, x2);
+        (b.with_damping(1e-4), x0)
     }
 
     /// The iteration matrix of the damped beam (stiffness and rate parts) equals central
@@ -303,7 +268,9 @@ mod tests {
             let n = st.len();
             let mut f = vec![Vector3::zeros(); 2 * n];
             let power = b.damping_forces(&b.states(&st), &b.shifts(&st), &mut f);
-            let work: f64 = (0..n).map(|i| f[2 * i].dot(&st[i].v) + f[2 * i + 1].dot(&st[i].w)).sum();
+            let work: f64 = (0..n)
+                .map(|i| f[2 * i].dot(&st[i].v) + f[2 * i + 1].dot(&st[i].w))
+                .sum();
             assert!(power > 0.0);
             assert!((work - power).abs() < 1e-10 * power, "{work} vs {power}");
             let (vv, ww) = (Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.7, -2.0));
