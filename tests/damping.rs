@@ -2,7 +2,7 @@
 //! the closed form of a cantilever's first mode, `ζ₁ = η ω₁ / 2`, and the energy balance.
 
 use mecano::deck::parse_deck;
-use mecano::model::{Model, NodeId};
+use mecano::model::Model;
 use mecano::output::History;
 use mecano::solver;
 use std::f64::consts::PI;
