@@ -91,8 +91,8 @@ fn the_reference_documents_only_accepted_keywords() {
     );
 }
 
-#[test]
-fn the_examples_parse() {
+/// The example decks: the fenced blocks from `## Full example` on.
+fn examples() -> Vec<String> {
     let text = grammar();
     let start = text
         .find("## Full example")
@@ -110,6 +110,12 @@ fn the_examples_parse() {
             b.push('\n');
         }
     }
+    blocks
+}
+
+#[test]
+fn the_examples_parse() {
+    let blocks = examples();
     assert!(blocks.len() >= 2, "expected the examples");
     for b in &blocks {
         if let Err(e) = parse_deck(b, "grammar.md example") {
@@ -119,4 +125,31 @@ fn the_examples_parse() {
     // The first example is the scene of decks/pendulum.dat.
     let m = parse_deck(&blocks[0], "example").expect("parses");
     assert_eq!((m.nodes.len(), m.elements.len()), (24, 25));
+}
+
+/// Every example runs (not only parses): its model builds (no documented feature is
+/// refused) and the analysis completes with finite states — a dynamic one cut to ten of
+/// its steps to keep the test cheap, a static one in full.
+#[test]
+fn the_examples_run() {
+    for (k, b) in examples().iter().enumerate() {
+        let mut m = parse_deck(b, "grammar.md example").expect("parses");
+        if let mecano::model::Analysis::Dynamic { step, .. } = m.analysis {
+            assert!(m.set_fixed_step(step, 10.0 * step, None));
+        }
+        let mut h = mecano::output::History::new(1);
+        let report = mecano::solver::run(&m, &mut h)
+            .unwrap_or_else(|e| panic!("example {k} does not start: {e:?}"));
+        assert!(
+            report.failure.is_none(),
+            "example {k} failed: {:?}",
+            report.failure
+        );
+        let last = h.nodes.last().expect("states recorded");
+        assert!(
+            last.iter()
+                .all(|s| s.x.iter().chain(s.r.iter()).all(|v| v.is_finite())),
+            "example {k}: non-finite state"
+        );
+    }
 }

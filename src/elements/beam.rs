@@ -24,6 +24,11 @@
 //! Consistent translational mass `ρAL/6 [2 1; 1 2]`, and rotary inertia lumped at the
 //! nodes, `J = (L/2) Λ₀ ρ diag(I₂+I₃, I₂, I₃) Λ₀ᵀ` in the node's material frame, with the
 //! gyroscopic force `J Ω̇ + Ω × J Ω`. Gravity: `ρAL g / 2` on each node.
+//!
+//! # Damping
+//! A beam whose material has `DAMPING η` is built as the order-1 [`super::beam_p::BeamP`]
+//! (the same element, tested equal), which carries the Kelvin–Voigt damping stresses
+//! `η C (Γ̇, K̇)` (`beam_p/damping.rs`); this element is the undamped fast path.
 
 use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::dual::{Dual, Real};

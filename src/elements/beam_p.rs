@@ -105,6 +105,8 @@ pub struct BeamP {
     /// Rotary inertia at each node, node material frame.
     j_node: Vec<Matrix3<f64>>,
     length: f64,
+    /// Stiffness-proportional damping coefficient η, s (0: none; [`damping`]).
+    eta: f64,
 }
 
 /// Scratch buffers of the evaluation, one per thread (grown once: no allocation per step).
@@ -263,6 +265,7 @@ impl BeamP {
             lumped,
             j_node,
             length,
+            eta: 0.0,
         };
         // Reference strains: the same expressions at the reference state.
         let rest: Vec<NodeState> = x0.iter().map(|x| NodeState::at_rest(*x)).collect();
@@ -403,16 +406,32 @@ impl BeamP {
         let cm: Vector3<S> = self.props.cm.map(c);
         let nn = (a - q.gamma0.map(c::<S>)).component_mul(&cn);
         let mm = (rotation::mv(&t, &dpsi) - q.kappa0.map(c::<S>)).component_mul(&cm);
-        let g_dy = rotation::mv(&e, &nn);
-        let g_dpsi = rotation::mtv(&t, &mm);
-        let (b, d, db, dd) = t_coefficients(psi.dot(&psi));
-        let pv = psi.cross(&dpsi);
+        Self::stress_grad(&psi, &dpsi, &e, &t, &a, &nn, &mm)
+    }
+
+    /// The virtual work of the stresses `N`, `M` per unit length, `δΓ·N + δK·M`, as a
+    /// gradient in the nine local numbers `(ψ, ψ_s, y_s)` of a point (the formulas of
+    /// [`Self::density_grad`] for any `N`, `M`: elastic or damping stresses), given
+    /// `e = exp(ψ̃)`, `t = T(ψ)` and `a = exp(ψ̃)ᵀ y_s`.
+    fn stress_grad<S: Real>(
+        psi: &Vector3<S>,
+        dpsi: &Vector3<S>,
+        e: &Matrix3<S>,
+        t: &Matrix3<S>,
+        a: &Vector3<S>,
+        nn: &Vector3<S>,
+        mm: &Vector3<S>,
+    ) -> [S; 9] {
+        let g_dy = rotation::mv(e, nn);
+        let g_dpsi = rotation::mtv(t, mm);
+        let (b, d, db, dd) = t_coefficients(psi.dot(psi));
+        let pv = psi.cross(dpsi);
         let ppv = psi.cross(&pv);
         let two = c::<S>(2.0);
-        let g_psi = rotation::mtv(&t, &nn.cross(&a)) - psi * (db * two * pv.dot(&mm))
-            + mm.cross(&dpsi) * b
-            + psi * (dd * two * ppv.dot(&mm))
-            - (mm.cross(&pv) + mm.cross(&psi).cross(&dpsi)) * d;
+        let g_psi = rotation::mtv(t, &nn.cross(a)) - *psi * (db * two * pv.dot(mm))
+            + mm.cross(dpsi) * b
+            + *psi * (dd * two * ppv.dot(mm))
+            - (mm.cross(&pv) + mm.cross(psi).cross(dpsi)) * d;
         [
             g_psi.x, g_psi.y, g_psi.z, g_dpsi.x, g_dpsi.y, g_dpsi.z, g_dy.x, g_dy.y, g_dy.z,
         ]
@@ -462,6 +481,9 @@ impl Element for BeamP {
         }
         if !ctx.dynamic {
             return;
+        }
+        if self.eta > 0.0 {
+            self.add_damping(ctx, nodes, tangent, out);
         }
         for i in 0..n {
             let mut f = Vector3::zeros();
@@ -525,6 +547,14 @@ impl Element for BeamP {
         }
     }
 
+    fn dissipated_power(&self, nodes: &[NodeState]) -> f64 {
+        if self.eta > 0.0 {
+            self.damping_power(nodes)
+        } else {
+            0.0
+        }
+    }
+
     fn output_header(&self) -> Vec<String> {
         [
             "n1", "n2", "n3", "m1", "m2", "m3", "gamma1", "gamma2", "gamma3", "k1", "k2", "k3",
@@ -551,10 +581,11 @@ impl Element for BeamP {
 }
 
 mod build;
+mod damping;
 mod residual;
 mod tangent;
 
-pub use build::from_model;
+pub use build::{from_model, properties, with_properties};
 
 #[cfg(test)]
 #[path = "beam_p_tests.rs"]

@@ -18,7 +18,7 @@ pub(crate) fn steel_props() -> BeamProperties {
 
 /// A straight beam of order `p` from `x1` to `x2`, nodes at the GLL points; returns the
 /// element and the nodes' reference positions.
-fn straight(p: usize, x1: Vector3<f64>, x2: Vector3<f64>) -> (BeamP, Vec<Vector3<f64>>) {
+pub(super) fn straight(p: usize, x1: Vector3<f64>, x2: Vector3<f64>) -> (BeamP, Vec<Vector3<f64>>) {
     let (xi, _) = lagrange::gll(p);
     let x0: Vec<_> = xi
         .iter()

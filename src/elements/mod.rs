@@ -21,6 +21,7 @@ pub mod came;
 pub mod joints;
 pub mod mass;
 pub mod profile;
+pub mod rigid_bar;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -54,21 +55,8 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
     let mut unsupported = Vec::new();
     for el in model.elements.values() {
         match &el.kind {
-            ElementKind::Beam {
-                material,
-                section,
-                order,
-                ..
-            } => {
-                let (mat, sec) = (&model.materials[material], &model.sections[section]);
-                if sec.rigid {
-                    unsupported.push(format!("{} (BEAM with a RIGID section)", el.id));
-                    continue;
-                }
-                if mat.damping > 0.0 {
-                    unsupported.push(format!("{} (material DAMPING)", el.id));
-                    continue;
-                }
+            ElementKind::Beam { section, order, .. } => {
+                let sec = &model.sections[section];
                 let nodes: Vec<usize> = el.nodes.iter().map(idx).collect();
                 if *order as usize > beam_p::MAX_ORDER
                     || (nodes.len() != 2 && nodes.len() != *order as usize + 1)
@@ -83,7 +71,11 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                         ),
                     });
                 }
-                out.push(beam_p::from_model(model, el, nodes));
+                if sec.rigid {
+                    out.push(Box::new(rigid_bar::RigidBar::from_model(model, el, nodes)?));
+                } else {
+                    out.push(beam_p::from_model(model, el, nodes));
+                }
             }
             ElementKind::Mass { mass, inertia } => {
                 out.push(Box::new(mass::PointMass::new(

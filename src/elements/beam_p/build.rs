@@ -7,7 +7,7 @@ use crate::elements::Element;
 use crate::elements::beam::{Beam, BeamProperties, default_axis2, reference_triad};
 use crate::lagrange;
 use crate::model::arc::Arc;
-use crate::model::{ElementKind, Model};
+use crate::model::{ElementKind, Material, Model, Section};
 use nalgebra::{Matrix3, Vector3};
 
 /// The solver element of a model's beam whose nodes (dense indices, along the axis) are
@@ -23,17 +23,19 @@ pub fn from_model(
     nodes: Vec<usize>,
 ) -> Box<dyn Element> {
     let ElementKind::Beam {
-        material,
-        section,
-        axis2,
-        arc,
-        ..
+        material, section, ..
     } = &el.kind
     else {
         unreachable!("from_model is called on beams only")
     };
     let (mat, sec) = (&model.materials[material], &model.sections[section]);
-    let props = BeamProperties {
+    with_properties(model, el, nodes, properties(mat, sec), mat.damping)
+}
+
+/// The per-length properties of a beam of material `mat` and section `sec`:
+/// `C_N = (EA, kGA, kGA)`, `C_M = (GJ, EI₂, EI₃)`, `ρA`, `ρ(I₂ + I₃, I₂, I₃)`.
+pub fn properties(mat: &Material, sec: &Section) -> BeamProperties {
+    BeamProperties {
         cn: Vector3::new(
             mat.young * sec.area,
             sec.shear_factor * mat.shear * sec.area,
@@ -46,10 +48,26 @@ pub fn from_model(
         ),
         mass: mat.density * sec.area,
         inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
+    }
+}
+
+/// [`from_model`] with the given properties and damping coefficient `eta` (s; the
+/// rigid bar of [`crate::elements::rigid_bar`] passes zero stiffness).
+pub fn with_properties(
+    model: &Model,
+    el: &crate::model::Element,
+    nodes: Vec<usize>,
+    props: BeamProperties,
+    eta: f64,
+) -> Box<dyn Element> {
+    let ElementKind::Beam { axis2, arc, .. } = &el.kind else {
+        unreachable!("from_model is called on beams only")
     };
     let x0: Vec<Vector3<f64>> = nodes.iter().map(|&i| model.nodes[i].position).collect();
     let (xa, xb) = (x0[0], x0[x0.len() - 1]);
-    if nodes.len() == 2 {
+    // A damped two-node beam is the order-1 `BeamP` (the same element: tested equal in
+    // `beam_p_tests.rs`), which carries the damping (`beam_p/damping.rs`).
+    if nodes.len() == 2 && eta == 0.0 {
         return Box::new(Beam::new(
             el.id,
             [nodes[0], nodes[1]],
@@ -59,7 +77,10 @@ pub fn from_model(
             props,
         ));
     }
-    let curved = arc.and_then(|c| Arc::new(&xa, &xb, &c).ok());
+    // Two nodes: the chord of an `ARC` (as the two-node beam).
+    let curved = arc
+        .filter(|_| nodes.len() > 2)
+        .and_then(|c| Arc::new(&xa, &xb, &c).ok());
     let triads: Vec<Matrix3<f64>> = x0
         .iter()
         .map(|x| match &curved {
@@ -77,5 +98,5 @@ pub fn from_model(
         })
         .collect();
     let (xi, _) = lagrange::gll(nodes.len() - 1);
-    Box::new(BeamP::new(el.id, nodes, &xi, &x0, &triads, props))
+    Box::new(BeamP::new(el.id, nodes, &xi, &x0, &triads, props).with_damping(eta))
 }
