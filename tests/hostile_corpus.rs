@@ -98,7 +98,7 @@ fn mutate(text: &str, rng: &mut ChaCha8Rng) -> String {
     }
     let l = rng.random_range(0..lines.len());
     match rng.random_range(0..8) {
-        0 | 1 | 2 => {
+        0..=2 => {
             // Replace, delete or duplicate one field.
             let mut toks: Vec<String> = lines[l].split(' ').map(str::to_string).collect();
             let t = rng.random_range(0..toks.len());

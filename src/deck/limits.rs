@@ -35,17 +35,23 @@ fn floor_boundary(s: &str, mut i: usize) -> usize {
     i
 }
 
-fn broken(what: &'static str, limit: usize, unit: &'static str, span: Span, cut: usize) -> Broken {
-    Broken {
+fn broken(
+    what: &'static str,
+    limit: usize,
+    unit: &'static str,
+    span: Span,
+    cut: usize,
+) -> Box<Broken> {
+    Box::new(Broken {
         error: DeckError::new(DeckErrorKind::TooLarge { what, limit, unit }, span),
         cut,
-    }
+    })
 }
 
 /// Checks the line lengths of `source` and its size; `total` is the size of the whole
 /// file (larger than `source` when only its beginning was read). One pass over the
 /// bytes, stopping at the first limit broken.
-pub(crate) fn check_text(source: &str, total: usize) -> Result<(), Broken> {
+pub(crate) fn check_text(source: &str, total: usize) -> Result<(), Box<Broken>> {
     let mut start = 0;
     for line in source.split('\n') {
         if line.len() > MAX_LINE_BYTES {
@@ -77,7 +83,7 @@ pub(crate) fn check_text(source: &str, total: usize) -> Result<(), Broken> {
 }
 
 /// Checks the fields of the lexed lines (their length and number per card).
-pub(crate) fn check_lines(source: &str, lines: &[Line<'_>]) -> Result<(), Broken> {
+pub(crate) fn check_lines(source: &str, lines: &[Line<'_>]) -> Result<(), Box<Broken>> {
     for line in lines {
         if let Some(t) = line.tokens.get(MAX_CARD_FIELDS) {
             let at = t.span.start;

@@ -389,7 +389,8 @@ pub fn parse_deck_with(
     file_name: &str,
     overrides: &[(String, f64)],
 ) -> Result<Model, DeckErrors> {
-    let too_large = |b: limits::Broken| DeckErrors::new(&source[..b.cut], file_name, vec![b.error]);
+    let too_large =
+        |b: Box<limits::Broken>| DeckErrors::new(&source[..b.cut], file_name, vec![b.error]);
     limits::check_text(source, source.len()).map_err(too_large)?;
     let lines = lex::lex(source);
     limits::check_lines(source, &lines).map_err(too_large)?;
@@ -471,15 +472,17 @@ pub fn load_deck_with(path: &Path, overrides: &[(String, f64)]) -> Result<Model,
             // large, not malformed.
             let cut_inside = total > limits::MAX_DECK_BYTES && offset + 4 > limits::MAX_DECK_BYTES;
             let checked = limits::check_text(text, if cut_inside { total } else { offset });
-            let error = checked.err().unwrap_or_else(|| limits::Broken {
-                error: DeckError::new(
-                    DeckErrorKind::NotUtf8 {
-                        path: name.clone(),
-                        offset,
-                    },
-                    Span::new(offset, offset),
-                ),
-                cut: offset,
+            let error = checked.err().unwrap_or_else(|| {
+                Box::new(limits::Broken {
+                    error: DeckError::new(
+                        DeckErrorKind::NotUtf8 {
+                            path: name.clone(),
+                            offset,
+                        },
+                        Span::new(offset, offset),
+                    ),
+                    cut: offset,
+                })
             });
             Err(DeckErrors::new(
                 &text[..error.cut],
