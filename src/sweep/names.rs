@@ -43,31 +43,24 @@ pub fn check(text: &str, path: &Path, plan: &Plan) -> Result<(), SweepError> {
         .map(|n| ("reference", n))
         .chain(f.guide.iter().map(|n| ("guide", n)));
     for (table, n) in tables {
-        let q = n.quantity.get_ref();
-        if !plan.quantities.iter().any(|x| &x.name == q) {
-            let known: Vec<&str> = plan.quantities.iter().map(|x| x.name.as_str()).collect();
-            return Err(SweepError::Plan {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "line {}: [[{table}]] quantity `{}` is not a quantity of the plan ({})",
-                    line(text, n.quantity.span().start),
-                    crate::deck::short(q),
-                    known.join(", ")
-                ),
-            });
-        }
-        let p = n.parameter.get_ref();
-        if !plan.params.iter().any(|x| &x.name == p) {
-            let known: Vec<&str> = plan.params.iter().map(|x| x.name.as_str()).collect();
-            return Err(SweepError::Plan {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "line {}: [[{table}]] parameter `{}` is not a parameter of the plan ({})",
-                    line(text, n.parameter.span().start),
-                    crate::deck::short(p),
-                    known.join(", ")
-                ),
-            });
+        let quantities = plan.quantities.iter().map(|x| x.name.as_str());
+        let params = plan.params.iter().map(|x| x.name.as_str());
+        let fields: [(&str, &Spanned<String>, Vec<&str>); 2] = [
+            ("quantity", &n.quantity, quantities.collect()),
+            ("parameter", &n.parameter, params.collect()),
+        ];
+        for (field, name, known) in fields {
+            if !known.contains(&name.get_ref().as_str()) {
+                return Err(SweepError::Plan {
+                    path: path.to_path_buf(),
+                    msg: format!(
+                        "line {}: [[{table}]] {field} `{}` is not a {field} of the plan ({})",
+                        line(text, name.span().start),
+                        crate::deck::short(name.get_ref()),
+                        known.join(", ")
+                    ),
+                });
+            }
         }
     }
     Ok(())

@@ -7,21 +7,7 @@ use super::*;
 use crate::model::Profile;
 
 /// A joint, RIGID or CAME that names one node twice: located at the second mention.
-pub(super) fn same_node(ty: &str, element: u32, nodes: &[(u32, Span)]) -> R<()> {
-    const KEYWORDS: [&str; 7] = [
-        "HINGE",
-        "UJOINT",
-        "SPHERICAL",
-        "CLAMP",
-        "PRISMATIC",
-        "RIGID",
-        "CAME",
-    ];
-    let keyword = KEYWORDS
-        .iter()
-        .find(|k| **k == ty)
-        .copied()
-        .unwrap_or("element");
+pub(super) fn same_node(keyword: &'static str, element: u32, nodes: &[(u32, Span)]) -> R<()> {
     for (i, (n, span)) in nodes.iter().enumerate() {
         if nodes[..i].iter().any(|(m, _)| m == n) {
             return Err(DeckError::new(
