@@ -71,7 +71,7 @@ impl RunOptions {
 pub fn parse_set(arg: &str) -> Result<(String, f64), String> {
     let (name, value) = arg
         .split_once('=')
-        .ok_or_else(|| format!("expected NAME=VALUE, found `{arg}`"))?;
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{}`", deck::short(arg)))?;
     let name = name.trim().trim_start_matches('$');
     let valid = name
         .chars()
@@ -79,10 +79,11 @@ pub fn parse_set(arg: &str) -> Result<(String, f64), String> {
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
     if !valid {
-        return Err(format!("`{name}` is not a parameter name"));
+        return Err(format!("`{}` is not a parameter name", deck::short(name)));
     }
-    let v = deck::eval_constant(value.trim())
-        .ok_or_else(|| format!("`{value}` is not a finite number or expression of numbers"))?;
+    let v = deck::eval_constant_located(value.trim()).map_err(|(column, why)| {
+        format!("the value of `{name}`, at its character {column}: {why}")
+    })?;
     Ok((name.to_string(), v))
 }
 
@@ -129,8 +130,11 @@ pub fn load_identified(
     set: &[(String, f64)],
     refine: u32,
 ) -> Result<(Model, DeckIdentity), u8> {
-    let text = match std::fs::read(path).map(String::from_utf8) {
-        Ok(Ok(t)) => t,
+    // A file beyond the deck size limit is not read whole: the loader refuses it.
+    let too_large =
+        std::fs::metadata(path).is_ok_and(|m| m.len() > deck::limits::MAX_DECK_BYTES as u64);
+    let text = match (!too_large).then(|| std::fs::read(path).map(String::from_utf8)) {
+        Some(Ok(Ok(t))) => t,
         // Unreadable or not UTF-8: the loader says so, with its diagnostics.
         _ => return Err(load_with(path, set).err().unwrap_or(EXIT_BAD_INPUT)),
     };

@@ -486,5 +486,6 @@ fn not_utf8_file() {
         msg.contains("not UTF-8") && msg.contains("offset 9"),
         "{msg}"
     );
-    assert_eq!(errs.errors()[0].span, None);
+    // Issue 28 §5: located (line 1, column 10), not only an offset.
+    assert_eq!(errs.line_col(0), Some((1, 10)));
 }

@@ -219,7 +219,8 @@ fn failed_cases_are_recorded_and_the_others_go_on() {
     )
     .expect("write");
     let r = run(&["sweep", plan.to_str().expect("utf-8"), "-q"]);
-    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    // Issue 28 §5: cases not ok make the sweep exit 1 (it still ran and collected all).
+    assert_eq!(r.status.code(), Some(1), "{}", text(&r));
     let t = rows(&dir.join("out"));
     let st = col(&t, "status");
     let diag = col(&t, "diagnosis");
@@ -398,7 +399,8 @@ fn a_diverging_case_is_recorded_with_its_diagnosis() {
         out.to_str().expect("utf-8"),
         "-q",
     ]);
-    assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+    // Issue 28 §5: a failed case makes the sweep exit 1.
+    assert_eq!(r.status.code(), Some(1), "case 1 fails: {}", text(&r));
     let t = rows(&out);
     let (st, diag) = (col(&t, "status"), col(&t, "diagnosis"));
     assert_eq!(t[1][st], "ok");

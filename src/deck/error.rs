@@ -18,7 +18,9 @@ pub enum DeckErrorKind {
         reason: String,
     },
     /// The deck file is not UTF-8 text.
-    #[error("deck file `{path}` is not UTF-8 text (invalid byte at offset {offset})")]
+    #[error(
+        "deck file `{path}` is not UTF-8 text (invalid byte at offset {offset}): the whole file must be UTF-8, also after END"
+    )]
     NotUtf8 {
         /// The path as given.
         path: String,
@@ -288,6 +290,54 @@ pub enum DeckErrorKind {
         /// The part that overflowed or is undefined.
         what: String,
     },
+    /// An expression nested deeper than the parser allows (issue 28: a stack overflow
+    /// before).
+    #[error(
+        "expression `{text}` is nested too deeply: at most {limit} levels of parentheses, calls, signs and powers"
+    )]
+    ExpressionTooDeep {
+        /// The whole field.
+        text: String,
+        /// The deepest nesting allowed.
+        limit: usize,
+    },
+    /// A deck beyond what the reader accepts (grammar.md, "Limits"): refused before it
+    /// can exhaust time or memory.
+    #[error("{what} exceeds the limit of {limit} {unit} (see grammar.md, Limits)")]
+    TooLarge {
+        /// What is too large (the deck, a line, a field, a card).
+        what: &'static str,
+        /// The limit.
+        limit: usize,
+        /// Its unit (bytes, fields).
+        unit: &'static str,
+    },
+    /// A joint or CAME whose nodes repeat one node.
+    #[error("{keyword} element {element} joins node {node} to itself: its nodes must differ")]
+    NodeToItself {
+        /// HINGE, RIGID, SPHERICAL, CAME, ...
+        keyword: &'static str,
+        /// Element number.
+        element: u32,
+        /// The repeated node.
+        node: u32,
+    },
+    /// A CAME whose two profiles cannot touch or are not supported together.
+    #[error("CAME element {element}: {reason}")]
+    CameProfiles {
+        /// Element number.
+        element: u32,
+        /// Why (and what to give instead).
+        reason: &'static str,
+    },
+    /// SPLINE points that do not make a curve (two consecutive ones coincide).
+    #[error("SPLINE point {index} coincides with point {previous}: consecutive points must differ")]
+    SplinePointsCoincide {
+        /// 1-based number of the point.
+        index: usize,
+        /// 1-based number of the point it repeats.
+        previous: usize,
+    },
     /// A PARAMETERS card whose first field is not a valid name.
     #[error(
         "bad parameter name `{found}`: expected a letter or `_` followed by letters, digits or `_`"
@@ -364,12 +414,18 @@ impl DeckError {
             | K::UJointNotPerpendicular { .. } => "mecano::deck::axis",
             K::OutOfRange { .. } => "mecano::deck::range",
             K::OddTable { .. } | K::DecreasingTime { .. } => "mecano::deck::table",
-            K::BadExpression { .. } | K::UnknownFunction { .. } => "mecano::deck::expression",
+            K::BadExpression { .. } | K::UnknownFunction { .. } | K::ExpressionTooDeep { .. } => {
+                "mecano::deck::expression"
+            }
             K::ExpressionNotFinite { .. } => "mecano::deck::expression_value",
             K::UndefinedParameter { .. } | K::UnknownOverride { .. } => {
                 "mecano::deck::undefined_parameter"
             }
             K::BadParameterName { .. } | K::DuplicateParameter { .. } => "mecano::deck::parameter",
+            K::TooLarge { .. } => "mecano::deck::too_large",
+            K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
+                "mecano::deck::element"
+            }
         }
     }
 
@@ -409,6 +465,66 @@ impl DeckError {
     }
 }
 
+/// The most characters of a token an error message echoes (issue 28: a 50 MB field
+/// was repeated whole in its message).
+pub const ECHO_CHARS: usize = 40;
+
+/// `s` cut to its first [`ECHO_CHARS`] characters, with `…` when something was cut.
+pub fn short(s: &str) -> String {
+    match s.char_indices().nth(ECHO_CHARS) {
+        Some((i, _)) => format!("{}…", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+impl DeckErrorKind {
+    /// Cuts every echo of the deck's text to [`short`] (lists of names to a few times
+    /// that), so that no message grows with the input.
+    pub(crate) fn shorten(&mut self) {
+        use DeckErrorKind as K;
+        let cut = |s: &mut String| *s = short(s);
+        let cut_list = |s: &mut String| {
+            if let Some((i, _)) = s.char_indices().nth(8 * ECHO_CHARS) {
+                s.truncate(i);
+                s.push('…');
+            }
+        };
+        match self {
+            K::UnknownSection { found, .. }
+            | K::CardOutsideSection { found, .. }
+            | K::UnknownKeyword { found, .. }
+            | K::UnknownElementType { found }
+            | K::ExpectedNumber { found, .. }
+            | K::ExpectedInteger { found, .. }
+            | K::NonFinite { found, .. }
+            | K::ExtraToken { found, .. }
+            | K::OutOfRange { found, .. }
+            | K::BadParameterName { found } => cut(found),
+            K::RepeatedKeyword { keyword, .. } => cut(keyword),
+            K::BadAxis { x, y, z, .. } => [x, y, z].into_iter().for_each(cut),
+            K::DecreasingTime { found, previous } => {
+                cut(found);
+                cut(previous);
+            }
+            K::BadExpression { text, .. } | K::ExpressionTooDeep { text, .. } => cut(text),
+            K::ExpressionNotFinite { text, what } => {
+                cut(text);
+                cut(what);
+            }
+            K::UnknownFunction { name, text } => {
+                cut(name);
+                cut(text);
+            }
+            K::UndefinedParameter { name, known } | K::UnknownOverride { name, known } => {
+                cut(name);
+                cut_list(known);
+            }
+            K::DuplicateParameter { name, .. } => cut(name),
+            _ => {}
+        }
+    }
+}
+
 impl fmt::Display for DeckError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         self.kind.fmt(f)
@@ -440,6 +556,7 @@ pub struct DeckErrors {
 impl DeckErrors {
     /// Wraps `errors` (sorted by position, file errors first) with the deck's text.
     pub fn new(source: &str, file_name: &str, mut errors: Vec<DeckError>) -> Self {
+        errors.iter_mut().for_each(|e| e.kind.shorten());
         errors.sort_by_key(|e| e.span.map(|s| (s.start, s.end)));
         DeckErrors {
             source: NamedSource::new(file_name, source.to_string()),

@@ -12,6 +12,9 @@
 //! name    = letter { letter | digit | "_" } ;    (* letters: A-Z, a-z, _ *)
 //! ```
 //!
+//! Nesting (parentheses, function calls, signs and powers, which nest to the right) is at
+//! most [`MAX_DEPTH`] deep: a deeper expression is a located error, not a stack overflow.
+//!
 //! Blanks are allowed anywhere (the lexer keeps the blanks inside parentheses within one
 //! field). Function names and `pi` are case-insensitive; parameter names are case-sensitive.
 //! Evaluation is in `f64`; a result (or an intermediate value) that is not finite is an
@@ -41,7 +44,14 @@ pub(crate) enum ExprErrorKind {
     UnknownFunction { name: String },
     /// The value is not finite (e.g. `sqrt(-1)`, `1/0`, `1e200*1e200`).
     NotFinite { what: String },
+    /// Parentheses, calls, signs or powers nested deeper than [`MAX_DEPTH`].
+    TooDeep,
 }
+
+/// The deepest nesting an expression may have: each `(`, function call, unary sign and
+/// `^` opens one level. Far beyond any formula a deck needs, and small enough that the
+/// recursive descent stays well inside a thread's stack (a few hundred bytes per level).
+pub const MAX_DEPTH: usize = 100;
 
 /// The functions an expression may call.
 pub(crate) const FUNCTIONS: [&str; 6] = ["sqrt", "sin", "cos", "exp", "log", "abs"];
@@ -67,6 +77,7 @@ pub(crate) fn eval(text: &str, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f
     let mut p = Parser {
         s: text.as_bytes(),
         pos: 0,
+        depth: 0,
         lookup,
     };
     let v = p.expr()?;
@@ -100,6 +111,8 @@ fn finite(v: f64, at: usize, len: usize, what: &str) -> Result<f64, ExprError> {
 struct Parser<'s, 'f> {
     s: &'s [u8],
     pos: usize,
+    /// Levels of [`Parser::unary`] under way: every recursive path goes through it.
+    depth: usize,
     lookup: &'f dyn Fn(&str) -> Option<f64>,
 }
 
@@ -169,7 +182,27 @@ impl Parser<'_, '_> {
         Ok(v)
     }
 
+    /// Every recursion of the grammar (parentheses and calls via `expr`, signs, powers)
+    /// passes here, so the depth is bounded here.
     fn unary(&mut self) -> Result<f64, ExprError> {
+        if self.depth >= MAX_DEPTH {
+            self.blanks();
+            return Err(ExprError {
+                at: self.pos,
+                len: std::str::from_utf8(&self.s[self.pos..])
+                    .ok()
+                    .and_then(|r| r.chars().next())
+                    .map_or(0, char::len_utf8),
+                kind: ExprErrorKind::TooDeep,
+            });
+        }
+        self.depth += 1;
+        let v = self.unary_inner();
+        self.depth -= 1;
+        v
+    }
+
+    fn unary_inner(&mut self) -> Result<f64, ExprError> {
         match self.peek() {
             Some(b'-') => {
                 self.pos += 1;
@@ -385,6 +418,35 @@ mod tests {
         assert_eq!((e.at, e.len), (2, 2));
         assert!(ev("").is_err());
         assert!(ev("sqrt 2").is_err());
+    }
+
+    /// Issue 28 §2: 100,000 nested parentheses, calls, signs or powers are a located
+    /// error at the first level past [`MAX_DEPTH`], not a stack overflow.
+    #[test]
+    fn deep_nesting_is_a_located_error() {
+        let n = 100_000;
+        let cases = [
+            format!("{}1{}", "(".repeat(n), ")".repeat(n)),
+            format!("{}1{}", "sqrt(".repeat(n), ")".repeat(n)),
+            format!("{}1", "-".repeat(n)),
+            vec!["1"; n].join("^"),
+            format!("{}1", "+ -".repeat(n)),
+        ];
+        for text in &cases {
+            let e = ev(text).unwrap_err();
+            assert_eq!(e.kind, ExprErrorKind::TooDeep, "{}", &text[..20]);
+            assert!(e.at > 0 && e.at < 1000, "{}", e.at);
+        }
+        // At the limit it still evaluates: MAX_DEPTH - 1 parentheses (the outermost
+        // level is the expression itself).
+        let ok = format!(
+            "{}2{}",
+            "(".repeat(MAX_DEPTH - 1),
+            ")".repeat(MAX_DEPTH - 1)
+        );
+        assert_eq!(ev(&ok), Ok(2.0));
+        let ok = vec!["1"; MAX_DEPTH].join("^");
+        assert_eq!(ev(&ok), Ok(1.0));
     }
 
     #[test]

@@ -14,10 +14,11 @@ mod cards;
 mod error;
 mod expr;
 mod lex;
+pub mod limits;
 mod params;
 mod write;
 
-pub use error::{DeckError, DeckErrorKind, DeckErrors};
+pub use error::{DeckError, DeckErrorKind, DeckErrors, ECHO_CHARS, short};
 pub use write::write_deck;
 
 use crate::model::{Model, Span};
@@ -84,7 +85,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "deck",
         "one-line section: what to write and where",
     ),
-    kw("END", "deck", "end of the deck: nothing after it is read"),
+    kw(
+        "END",
+        "deck",
+        "end of the deck: no card after it is read (the file is still checked: UTF-8, limits)",
+    ),
     kw(
         "PARAMETERS",
         "deck",
@@ -399,7 +404,11 @@ pub fn parse_deck_with(
     file_name: &str,
     overrides: &[(String, f64)],
 ) -> Result<Model, DeckErrors> {
+    let too_large =
+        |b: Box<limits::Broken>| DeckErrors::new(&source[..b.cut], file_name, vec![b.error]);
+    limits::check_text(source, source.len()).map_err(too_large)?;
     let lines = lex::lex(source);
+    limits::check_lines(source, &lines).map_err(too_large)?;
     let empty = lines.is_empty();
     let mut errors = Vec::new();
     let mut cards = cards::cards(lines, &mut errors);
@@ -419,6 +428,24 @@ pub fn eval_constant(text: &str) -> Option<f64> {
     expr::eval(text, &|_| None).ok()
 }
 
+/// [`eval_constant`] with the reason when it is not a value: the 1-based character
+/// column in `text` where the problem starts and what is wrong (echoing at most a short
+/// prefix of `text`).
+pub fn eval_constant_located(text: &str) -> Result<f64, (usize, String)> {
+    expr::eval(text, &|_| None).map_err(|e| {
+        let column = text[..e.at.min(text.len())].chars().count() + 1;
+        let tok = lex::Token {
+            text,
+            span: Span::new(0, text.len()),
+            number: None,
+            bad_expr: None,
+        };
+        let mut err = params::expr_error(&tok, e);
+        err.kind.shorten();
+        (column, err.kind.to_string())
+    })
+}
+
 /// Reads and parses a deck file. A missing or unreadable file, or one that is not UTF-8,
 /// gives a [`DeckErrors`] with a single error without span.
 pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
@@ -429,19 +456,56 @@ pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
 pub fn load_deck_with(path: &Path, overrides: &[(String, f64)]) -> Result<Model, DeckErrors> {
     let name = path.display().to_string();
     let file_error = |kind| DeckErrors::new("", &name, vec![DeckError { kind, span: None }]);
-    let bytes = std::fs::read(path).map_err(|e| {
+    let io = |e: std::io::Error| {
         file_error(DeckErrorKind::Io {
             path: name.clone(),
             reason: e.to_string(),
         })
-    })?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        file_error(DeckErrorKind::NotUtf8 {
-            path: name.clone(),
-            offset: e.utf8_error().valid_up_to(),
-        })
-    })?;
-    parse_deck_with(&text, &name, overrides)
+    };
+    // At most one byte past the limit is read: a larger file is refused, not loaded.
+    let mut bytes = Vec::new();
+    let file = std::fs::File::open(path).map_err(io)?;
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(file, limits::MAX_DECK_BYTES as u64 + 1),
+        &mut bytes,
+    )
+    .map_err(io)?;
+    let total = bytes.len();
+    match String::from_utf8(bytes) {
+        Ok(text) if total <= limits::MAX_DECK_BYTES => parse_deck_with(&text, &name, overrides),
+        Ok(text) => Err(limits::check_text(&text, total).err().map_or_else(
+            || file_error(DeckErrorKind::EmptyDeck),
+            |b| DeckErrors::new(&text[..b.cut], &name, vec![b.error]),
+        )),
+        Err(e) => {
+            // Located at the first invalid byte: the text before it is the source of the
+            // diagnostic (its lines are checked first, so the snippet stays short).
+            let offset = e.utf8_error().valid_up_to();
+            let valid = &e.as_bytes()[..offset];
+            let text = std::str::from_utf8(valid).unwrap_or_default();
+            // A file cut at the size limit may end inside a character: then it is too
+            // large, not malformed.
+            let cut_inside = total > limits::MAX_DECK_BYTES && offset + 4 > limits::MAX_DECK_BYTES;
+            let checked = limits::check_text(text, if cut_inside { total } else { offset });
+            let error = checked.err().unwrap_or_else(|| {
+                Box::new(limits::Broken {
+                    error: DeckError::new(
+                        DeckErrorKind::NotUtf8 {
+                            path: name.clone(),
+                            offset,
+                        },
+                        Span::new(offset, offset),
+                    ),
+                    cut: offset,
+                })
+            });
+            Err(DeckErrors::new(
+                &text[..error.cut],
+                &name,
+                vec![error.error],
+            ))
+        }
+    }
 }
 
 /// Sets every span in `model` to `Span::default()` (to compare models read from different

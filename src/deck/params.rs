@@ -48,8 +48,17 @@ fn deck_error(tok: &Token<'_>, e: ExprError, params: &IndexMap<String, (f64, Spa
         },
         ExprErrorKind::UnknownFunction { name } => K::UnknownFunction { name, text },
         ExprErrorKind::NotFinite { what } => K::ExpressionNotFinite { text, what },
+        ExprErrorKind::TooDeep => K::ExpressionTooDeep {
+            text,
+            limit: expr::MAX_DEPTH,
+        },
     };
     DeckError::new(kind, span)
+}
+
+/// [`deck_error`] outside a deck (no parameters defined): `--set name=value`.
+pub(crate) fn expr_error(tok: &Token<'_>, e: ExprError) -> DeckError {
+    deck_error(tok, e, &IndexMap::new())
 }
 
 /// The value of a field: its number, or its expression evaluated with `params`.

@@ -14,6 +14,7 @@
 
 pub mod collect;
 pub mod figures;
+pub mod names;
 pub mod plan;
 pub mod quantity;
 pub mod runner;
@@ -57,6 +58,9 @@ pub enum SweepError {
         "interrupted: the cases under way were checkpointed; run the same command again to go on"
     )]
     Interrupted,
+    /// A scheduler option (or path) the script cannot hold (bad input: exit 2).
+    #[error("{0}")]
+    Slurm(slurm::OptionError),
     /// `--case` names cases the plan does not have, or is malformed.
     #[error("--case {spec}: {msg}")]
     CaseSpec {
@@ -157,8 +161,9 @@ fn fmt_values(plan: &Plan, i: usize) -> String {
         .join(" ")
 }
 
-/// `mecano-rs sweep`: returns the exit code (0 every case finished — completed or failed
-/// with its diagnosis —; 1 cases could not be run or files not written; 2 bad plan or deck;
+/// `mecano-rs sweep`: returns the exit code (0 every case ran and is `ok`, or the script
+/// was written; 1 a case is not `ok` — failed, bad input, a quantity error or missing —
+/// or cases could not be run or files not written; 2 bad plan, deck or scheduler option;
 /// 130 interrupted by SIGINT/SIGTERM, the cases under way checkpointed).
 pub fn run(args: &SweepArgs) -> u8 {
     let plan = match Plan::load(&args.plan, args.out.as_deref()) {
@@ -200,6 +205,10 @@ pub fn run(args: &SweepArgs) -> u8 {
                 );
                 EXIT_OK
             }
+            Err(e @ SweepError::Slurm(_)) => {
+                eprintln!("error: {e}");
+                EXIT_BAD_INPUT
+            }
             Err(e) => {
                 eprintln!("error: {e}");
                 EXIT_FAILED
@@ -224,7 +233,13 @@ pub fn run(args: &SweepArgs) -> u8 {
         };
         let jobs = args.jobs.unwrap_or(default_jobs).max(1);
         let start = std::time::Instant::now();
-        match runner::run_local(&plan, &which, jobs, args.quiet, &crate::app::interrupts()) {
+        let any_not_ok = match runner::run_local(
+            &plan,
+            &which,
+            jobs,
+            args.quiet,
+            &crate::app::interrupts(),
+        ) {
             Ok((ran, not_ok)) => {
                 if !args.quiet {
                     let _ = writeln!(
@@ -235,6 +250,7 @@ pub fn run(args: &SweepArgs) -> u8 {
                         start.elapsed().as_secs_f64()
                     );
                 }
+                not_ok > 0
             }
             Err(SweepError::Interrupted) => {
                 eprintln!("{}: {}", args.plan.display(), SweepError::Interrupted);
@@ -244,9 +260,9 @@ pub fn run(args: &SweepArgs) -> u8 {
                 eprintln!("error: {e}");
                 return EXIT_FAILED;
             }
-        }
+        };
         if args.case.is_some() {
-            return EXIT_OK;
+            return if any_not_ok { EXIT_FAILED } else { EXIT_OK };
         }
     }
     match collect_and_draw(&plan) {
@@ -271,7 +287,14 @@ pub fn run(args: &SweepArgs) -> u8 {
                     std::fs::read_to_string(plan.out.join("statistics.csv")).unwrap_or_default()
                 );
             }
-            if missing > 0 { EXIT_FAILED } else { EXIT_OK }
+            // Issue 28 §5: a sweep whose cases failed (or whose quantities are missing)
+            // does not report success.
+            let ok = count(runner::Status::Ok);
+            if ok < c.records.len() {
+                EXIT_FAILED
+            } else {
+                EXIT_OK
+            }
         }
         Err(e) => {
             eprintln!("error: {e}");

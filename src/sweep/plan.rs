@@ -316,6 +316,7 @@ impl Plan {
             deck_hash,
         };
         plan.cases = plan.generate().map_err(|m| bad(path, m))?;
+        super::names::check(text, path, &plan)?;
         Ok(plan)
     }
 }

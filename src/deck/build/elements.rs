@@ -1,5 +1,6 @@
 //! Stage 2, ELEMENTS: beams, joints, masses, springs, contact (CAME) and profiles.
 
+use super::checks::{came_profiles, same_node, spline_points};
 use super::cursor::*;
 use super::*;
 use crate::model::order::MAX_ORDER;
@@ -223,10 +224,13 @@ impl Builder<'_> {
             _ => {
                 let cam = c.uint("cam node number")?;
                 let fol = c.uint("follower node number")?;
-                let data = Self::came(&mut c)?;
+                let data = Self::came(&mut c, id)?;
                 (vec![cam, fol], ElementKind::Came(Box::new(data)))
             }
         };
+        if ty != "BEAM" {
+            same_node(ty, id, &nodes)?;
+        }
         let mut ids = Vec::with_capacity(nodes.len());
         for (n, s) in nodes {
             ids.push(self.node_ref(n, s)?);
@@ -380,11 +384,14 @@ impl Builder<'_> {
                     return Err(out_of_range("number of SPLINE points", text, range, ns));
                 }
                 let mut points = Vec::new();
+                let mut spans = Vec::new();
                 for _ in 0..n {
-                    let (x, _, _) = c.number("SPLINE point x")?;
-                    let (y, _, _) = c.number("SPLINE point y")?;
+                    let (x, sx, _) = c.number("SPLINE point x")?;
+                    let (y, sy, _) = c.number("SPLINE point y")?;
                     points.push([x, y]);
+                    spans.push(Span::new(sx.start, sy.end));
                 }
+                spline_points(&points, &spans, closed)?;
                 Profile::Spline { points, closed }
             }
         };
@@ -433,7 +440,7 @@ impl Builder<'_> {
         })
     }
 
-    pub(super) fn came(c: &mut Cursor<'_, '_>) -> R<CameData> {
+    pub(super) fn came(c: &mut Cursor<'_, '_>, id: u32) -> R<CameData> {
         const KW: [&str; 8] = [
             "CAM",
             "FOLLOWER",
@@ -445,6 +452,7 @@ impl Builder<'_> {
             "IMPACT_STEPS",
         ];
         let mut seen = Seen::default();
+        let mut fol_span = c.end_span();
         let (mut cam, mut fol, mut k) = (None, None, None);
         let (mut damping, mut mu, mut vreg, mut clip, mut steps) = (0.0, 0.0, 1e-3, true, 10);
         while let Some(t) = c.peek() {
@@ -454,7 +462,10 @@ impl Builder<'_> {
             seen.add(kw, ks, &c.ctx)?;
             match kw {
                 "CAM" => cam = Some(Self::profile(c, "CAM")?),
-                "FOLLOWER" => fol = Some(Self::profile(c, "FOLLOWER")?),
+                "FOLLOWER" => {
+                    fol_span = ks;
+                    fol = Some(Self::profile(c, "FOLLOWER")?);
+                }
                 "K" => k = Some(c.number_in("K (contact stiffness)", "> 0 N/m", |v| v > 0.0)?),
                 "C" => damping = c.number_in("C (contact damping)", ">= 0 N·s/m", |v| v >= 0.0)?,
                 "MU" => mu = c.number_in("MU (friction coefficient)", ">= 0", |v| v >= 0.0)?,
@@ -480,6 +491,11 @@ impl Builder<'_> {
                 c.end_span(),
             )
         };
+        let (cam, fol) = (
+            cam.ok_or_else(|| miss("CAM <profile>"))?,
+            fol.ok_or_else(|| miss("FOLLOWER <profile>"))?,
+        );
+        came_profiles(id, &cam.profile, &fol.profile, fol_span)?;
         Ok(CameData {
             stiffness: k.ok_or_else(|| miss("K <contact stiffness>"))?,
             damping,
@@ -487,8 +503,8 @@ impl Builder<'_> {
             friction_speed: vreg,
             clip_tension: clip,
             impact_steps: steps,
-            cam: cam.ok_or_else(|| miss("CAM <profile>"))?,
-            follower: fol.ok_or_else(|| miss("FOLLOWER <profile>"))?,
+            cam,
+            follower: fol,
         })
     }
 }

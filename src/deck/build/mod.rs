@@ -2,6 +2,7 @@
 //! every value checked; all errors are gathered.
 
 mod analysis;
+mod checks;
 mod cursor;
 mod elements;
 mod nodes;
