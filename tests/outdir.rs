@@ -253,6 +253,13 @@ fn a_new_run_removes_the_previous_runs_files_and_refuses_foreign_ones_without_fo
         text(&o)
     );
     assert_eq!(fs::read(out.join("node_12.csv")).unwrap(), before);
+    // A directory of someone else's files only: refused, and nothing written into it.
+    let theirs = d.join("theirs");
+    fs::create_dir_all(&theirs).unwrap();
+    fs::write(theirs.join("node_12.csv"), "old").unwrap();
+    let o = run(&three, &theirs, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert_eq!(names(&theirs), ["node_12.csv"]);
     let o = run(&three, &out, &["--force"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert_eq!(fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");

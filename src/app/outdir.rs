@@ -4,8 +4,8 @@
 //!
 //! - **Lock.** `.mecano-lock` in the directory, held with `flock(2)` (`LOCK_EX | LOCK_NB`)
 //!   for the whole run or restart. The kernel releases it when the process ends, however
-//!   it ends (a crash, SIGKILL), so a lock is never left stuck; the file itself stays and
-//!   names the last holder's process id (for the message a refused run prints).
+//!   it ends (a crash, SIGKILL), so a lock is never left stuck; the file itself stays,
+//!   empty (a run's directory is the same, byte for byte, however often it was resumed).
 //! - **Manifest.** `.mecano-manifest`: one path per line, relative to the directory, of
 //!   every file this run may write (histories, `summary.json`, the checkpoint, the VTK
 //!   series). It is written before the first of them. A fresh run removes what the
@@ -18,7 +18,7 @@
 //! below a file, not creatable, a directory in use, or holding foreign files.
 
 use std::fs::{self, File, OpenOptions};
-use std::io::{self, Write};
+use std::io;
 use std::os::fd::AsRawFd;
 use std::path::{Path, PathBuf};
 
@@ -48,13 +48,11 @@ pub enum OutDirError {
     },
     /// Another run holds the directory's lock.
     #[error(
-        "the output directory {path} is in use by another mecano-rs run{holder}: two runs never write into one directory; wait for it to end, or choose another with -o"
+        "the output directory {path} is in use by another mecano-rs run (it holds {path}/.mecano-lock): two runs never write into one directory; wait for it to end, or choose another with -o"
     )]
     Busy {
         /// The directory.
         path: PathBuf,
-        /// ` (process N)` when the lock file names it.
-        holder: String,
     },
     /// Files not written by a run of this program.
     #[error(
@@ -103,22 +101,18 @@ impl OutDir {
         if dir.exists() && !dir.is_dir() {
             return Err(OutDirError::NotADirectory(dir.to_path_buf()));
         }
+        // Refused before anything is written into it (not even the lock file); checked
+        // again under the lock, which another run may have held meanwhile.
+        if dir.is_dir() && !force {
+            refuse_foreign(dir)?;
+        }
         fs::create_dir_all(dir).map_err(|e| unusable(dir, &e))?;
         let lock = lock(dir)?;
-        let old = read_manifest(dir).map_err(|e| unusable(dir, &e))?;
-        if !force {
-            let foreign = foreign_files(dir, &old).map_err(|e| unusable(dir, &e))?;
-            if !foreign.is_empty() {
-                let mut list: Vec<String> = foreign.iter().take(5).cloned().collect();
-                if foreign.len() > 5 {
-                    list.push(format!("and {} more", foreign.len() - 5));
-                }
-                return Err(OutDirError::Foreign {
-                    path: dir.to_path_buf(),
-                    list: list.join(", "),
-                });
-            }
-        }
+        let old = if force {
+            read_manifest(dir).map_err(|e| unusable(dir, &e))?
+        } else {
+            refuse_foreign(dir)?
+        };
         for entry in &old {
             remove_entry(dir, entry).map_err(|e| unusable(dir, &e))?;
         }
@@ -135,10 +129,27 @@ impl OutDir {
     }
 }
 
+/// The previous run's manifest, or the refusal of a directory holding other files.
+fn refuse_foreign(dir: &Path) -> Result<Vec<String>, OutDirError> {
+    let old = read_manifest(dir).map_err(|e| unusable(dir, &e))?;
+    let foreign = foreign_files(dir, &old).map_err(|e| unusable(dir, &e))?;
+    if foreign.is_empty() {
+        return Ok(old);
+    }
+    let mut list: Vec<String> = foreign.iter().take(5).cloned().collect();
+    if foreign.len() > 5 {
+        list.push(format!("and {} more", foreign.len() - 5));
+    }
+    Err(OutDirError::Foreign {
+        path: dir.to_path_buf(),
+        list: list.join(", "),
+    })
+}
+
 /// Opens (creating) the lock file and takes an exclusive, non-blocking `flock`.
 fn lock(dir: &Path) -> Result<File, OutDirError> {
     let path = dir.join(LOCK_NAME);
-    let mut file = OpenOptions::new()
+    let file = OpenOptions::new()
         .read(true)
         .write(true)
         .create(true)
@@ -150,20 +161,12 @@ fn lock(dir: &Path) -> Result<File, OutDirError> {
     if rc != 0 {
         let e = io::Error::last_os_error();
         if e.raw_os_error() == Some(libc::EWOULDBLOCK) {
-            let holder = fs::read_to_string(&path)
-                .ok()
-                .and_then(|s| s.trim().parse::<u32>().ok())
-                .map_or_else(String::new, |p| format!(" (process {p})"));
             return Err(OutDirError::Busy {
                 path: dir.to_path_buf(),
-                holder,
             });
         }
         return Err(unusable(dir, &e));
     }
-    // Ours now: name the holder (a message for the run that is refused).
-    let _ = file.set_len(0);
-    let _ = writeln!(file, "{}", std::process::id());
     Ok(file)
 }
 
