@@ -218,7 +218,7 @@ fn foreign_files(dir: &Path, old: &[String]) -> io::Result<Vec<String>> {
         let ours = name == LOCK_NAME
             || name == MANIFEST_NAME
             || name == format!("{MANIFEST_NAME}.tmp")
-            || old.iter().any(|o| *o == name);
+            || old.contains(&name);
         if !ours {
             out.push(name);
         }

@@ -603,7 +603,12 @@ impl Integrator {
                         self.residual_floor * self.sys.ref_length,
                     )
                 {
-                    return Err(self.failure(h, FailureReason::EnergyJump(j), history, fref));
+                    return Err(self.failure(
+                        h,
+                        FailureReason::EnergyJump(Box::new(j)),
+                        history,
+                        fref,
+                    ));
                 }
                 if self.dynamic
                     && let Some(a) = self.adaptive.clone()

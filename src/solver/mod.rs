@@ -57,7 +57,8 @@ pub enum FailureReason {
     StepRefused(f64),
     /// Newton converged to a state holding far more energy than the step's start state
     /// and work can pay for ([`energy_guard`]): a spurious root, refused like a divergence.
-    EnergyJump(energy_guard::EnergyJump),
+    /// (Boxed: `Failure` travels in `Result`s.)
+    EnergyJump(Box<energy_guard::EnergyJump>),
     /// The run was asked to stop at once ([`Integrator::abort`], e.g. a second Ctrl-C):
     /// not a failure of the step, which was given up.
     Aborted,
