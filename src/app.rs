@@ -5,6 +5,7 @@
 //! interrupted (SIGINT or SIGTERM: whole rows kept, a checkpoint to go on from with
 //! `mecano-rs resume`).
 
+pub mod outdir;
 mod resume;
 mod session;
 
@@ -50,6 +51,9 @@ pub struct RunOptions {
     pub refine: u32,
     /// Parameter overrides (`--set name=value`), in command-line order (the last wins).
     pub set: Vec<(String, f64)>,
+    /// `--force`: run into a directory holding files no run of this program wrote there
+    /// (they are left as they are; [`outdir`]).
+    pub force: bool,
 }
 
 impl RunOptions {
@@ -62,6 +66,7 @@ impl RunOptions {
             checkpoint,
             refine: 1,
             set: Vec::new(),
+            force: false,
         }
     }
 }
@@ -296,6 +301,7 @@ pub fn run_model(
         None,
         Interrupts::none(),
         false,
+        false,
     )
 }
 
@@ -314,10 +320,22 @@ pub fn run_checkpointed(
 ) -> Result<RunReport, (u8, String)> {
     let name = deck.path.clone();
     let plan = CheckpointPlan::new(every, deck);
-    start_session(model, &name, dir, true, Some(plan), interrupts, every_step)
+    start_session(
+        model,
+        &name,
+        dir,
+        true,
+        Some(plan),
+        interrupts,
+        every_step,
+        false,
+    )
 }
 
-/// Prepares the integrator and the writers of a fresh run, and executes it.
+/// Prepares the integrator, claims the output directory ([`outdir::OutDir::claim_fresh`]:
+/// its lock, the previous run's files removed, foreign files refused unless `force`),
+/// creates the writers of a fresh run, and executes it.
+#[allow(clippy::too_many_arguments)]
 fn start_session(
     model: &Model,
     deck_name: &str,
@@ -326,8 +344,15 @@ fn start_session(
     plan: Option<CheckpointPlan>,
     interrupts: Interrupts,
     every_step: bool,
+    force: bool,
 ) -> Result<RunReport, (u8, String)> {
     let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
+    let files = outdir::run_files(
+        crate::output::history_files(model, &integ.sys),
+        model.output.vtk,
+    );
+    let claim = outdir::OutDir::claim_fresh(dir, &files, force)
+        .map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
     let io_err = |e: std::io::Error| (EXIT_FAILED, format!("{}: {e}", dir.display()));
     // Output that cannot be opened stops the run before its first step, as bad input
     // does (issue 29: exit 2, the cause named; nothing is computed for nowhere).
@@ -363,6 +388,7 @@ fn start_session(
         plan,
         interrupts,
         resume: None,
+        claim,
     }
     .execute()
 }
@@ -466,6 +492,7 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         Some(plan),
         interrupts(),
         false,
+        opts.force,
     ) {
         Ok(report) => report_outcome(&what, &dir, opts.quiet, &report),
         Err((code, msg)) => {

@@ -47,6 +47,11 @@ struct Cli {
     /// No progress bar and no closing summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Run into an output directory that holds files no mecano-rs run wrote there (they
+    /// are left as they are). Without it such a directory is refused (exit code 2); the
+    /// files of the previous run there (listed in its .mecano-manifest) are always replaced.
+    #[arg(long)]
+    force: bool,
     /// Wall time between two checkpoints of the run's whole state (in the output
     /// directory, checkpoint.bin), seconds; 0: only at an interruption.
     #[arg(long, value_name = "SECONDS", default_value_t = mecano::app::DEFAULT_CHECKPOINT_SECONDS)]
@@ -112,6 +117,7 @@ fn main() -> ExitCode {
             &mecano::app::RunOptions {
                 refine: cli.refine,
                 set: cli.set.clone(),
+                force: cli.force,
                 ..mecano::app::RunOptions::new(cli.out, cli.quiet, cli.checkpoint)
             },
         ),

@@ -77,6 +77,8 @@ pub fn resume_run(
     if !dir.is_dir() {
         return Err(refuse("no such output directory"));
     }
+    // The same lock as a fresh run's: a restart never writes beside another run.
+    let claim = super::outdir::OutDir::lock_existing(dir).map_err(refuse)?;
     let summary: Option<serde_json::Value> = match std::fs::read_to_string(dir.join("summary.json"))
     {
         Ok(t) => match serde_json::from_str(&t) {
@@ -223,6 +225,7 @@ pub fn resume_run(
         plan: Some(CheckpointPlan::new(every, ck.deck)),
         interrupts,
         resume: Some(ck.control),
+        claim,
     };
     session.execute()
 }

@@ -153,6 +153,8 @@ pub(crate) struct Session<'a> {
     pub plan: Option<CheckpointPlan>,
     pub interrupts: Interrupts,
     pub resume: Option<LoopState>,
+    /// The output directory's lock (and manifest), held until the run ends.
+    pub claim: super::outdir::OutDir,
 }
 
 impl Session<'_> {
@@ -160,6 +162,11 @@ impl Session<'_> {
     /// report, or an exit code and message for errors that stop the run from starting.
     pub fn execute(mut self) -> Result<RunReport, (u8, String)> {
         let dir = self.dir;
+        debug_assert_eq!(
+            self.claim.path(),
+            dir,
+            "the run holds its own directory's lock"
+        );
         let bar = (!self.quiet && std::io::stderr().is_terminal()).then(|| {
             let pb = indicatif::ProgressBar::new(1000);
             pb.set_style(

@@ -128,6 +128,22 @@ pub struct WriterState {
     sampling: Option<Sampling>,
 }
 
+/// The names of the history files a model's OUTPUT asks for (node and element files, or
+/// `histories.nc` with `FORMAT NETCDF`, and `energy.csv`), relative to the output
+/// directory: what a run's manifest lists.
+pub fn history_files(model: &Model, sys: &System) -> Vec<String> {
+    let mut names = Vec::new();
+    if model.output.netcdf {
+        names.push(netcdf::FILE_NAME.to_string());
+    } else {
+        let (nodes, elements) = plan(Path::new(""), model, sys);
+        names.extend(nodes.iter().map(|(_, p)| stream::file_name(p)));
+        names.extend(elements.iter().map(|(_, p, _)| stream::file_name(p)));
+    }
+    names.push("energy.csv".to_string());
+    names
+}
+
 impl Writer {
     /// Creates the output directory, the files the model's OUTPUT requests, and a
     /// `summary.json` that says `"complete": false` until [`Writer::finish`] says otherwise.
@@ -446,14 +462,22 @@ impl Writer {
         integ: &crate::solver::Integrator,
         report: &RunReport,
     ) -> io::Result<()> {
-        if self.last_row != Some(integ.stats.steps) && report.interrupted.is_none() {
+        // (No state was accepted when the initial one could not be computed: no row.)
+        // Whatever happens to that row or the flush, the summary is written: every
+        // failure leaves its record (issue 28).
+        let last = if self.last_row.is_some()
+            && self.last_row != Some(integ.stats.steps)
+            && report.interrupted.is_none()
+        {
             self.write_state(&Snapshot {
                 integ,
                 step: integ.stats.steps,
                 h: 0.0,
-            })?;
-        }
-        self.flush()?;
+            })
+        } else {
+            Ok(())
+        };
+        let flushed = self.flush();
         let mut per_elem = serde_json::Map::new();
         for el in &integ.sys.elements {
             if let Some(s) = el.summary() {
@@ -461,7 +485,8 @@ impl Writer {
             }
         }
         let extra = (!per_elem.is_empty()).then_some(serde_json::Value::Object(per_elem));
-        self.write_summary(Some(report), extra)
+        self.write_summary(Some(report), extra)?;
+        last.and(flushed)
     }
 
     /// Largest relative energy-balance error so far.

@@ -4,6 +4,7 @@
 //! [`Observer`] (the output writers), so a run that stops early has already delivered
 //! what it computed.
 
+pub mod energy_guard;
 pub mod integrator;
 pub mod linear;
 pub mod redundancy;
@@ -54,6 +55,10 @@ pub enum FailureReason {
     /// Newton converged but an element refused the step as too long (e.g. an impact
     /// resolved by too few steps): retry with this step, s.
     StepRefused(f64),
+    /// Newton converged to a state holding far more energy than the step's start state
+    /// and work can pay for ([`energy_guard`]): a spurious root, refused like a divergence.
+    /// (Boxed: `Failure` travels in `Result`s.)
+    EnergyJump(Box<energy_guard::EnergyJump>),
     /// The run was asked to stop at once ([`Integrator::abort`], e.g. a second Ctrl-C):
     /// not a failure of the step, which was given up.
     Aborted,
@@ -94,6 +99,10 @@ impl std::fmt::Display for Failure {
                 format!("an element refused the step (asks for h <= {h:.3e} s)")
             }
             FailureReason::Aborted => "the run was aborted".to_string(),
+            FailureReason::EnergyJump(j) => format!(
+                "the step created {:.3e} J of energy that no work paid for (energy in play {:.3e} J before the step, {:.3e} J after, work of the step {:.3e} J): a spurious solution, refused",
+                j.created, j.before, j.after, j.work
+            ),
         };
         writeln!(
             f,

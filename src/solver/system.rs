@@ -100,6 +100,26 @@ pub struct System {
 pub struct AssemblyInfo {
     /// Largest absolute nodal contribution of any element (force scale).
     pub force_scale: f64,
+    /// Largest applied load at the assembly's time, N (moments divided by the reference
+    /// length), its norm computed without overflow.
+    pub load_scale: f64,
+}
+
+/// `|v|` without overflow or underflow of the squares: `m |v/m|`, `m = max |vᵢ|` (an
+/// infinite or NaN component gives infinity or NaN).
+pub fn safe_norm(v: &Vector3<f64>) -> f64 {
+    let m = v.iter().fold(0.0f64, |a, x| {
+        if a.is_nan() || x.is_nan() {
+            f64::NAN
+        } else {
+            a.max(x.abs())
+        }
+    });
+    if m == 0.0 || !m.is_finite() {
+        m
+    } else {
+        m * (v / m).norm()
+    }
 }
 
 impl System {
@@ -241,7 +261,7 @@ impl System {
                 Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
             });
             let scale = if l.moment { 1.0 / ref_length } else { 1.0 };
-            ref_force = ref_force.max(l.value.norm() * fmax * scale);
+            ref_force = ref_force.max(safe_norm(&l.value) * fmax * scale);
         }
         Ok(System {
             rhs: vec![0.0; n],
@@ -344,6 +364,8 @@ impl System {
         }
         for l in &self.loads {
             let f = l.at(ctx.t);
+            let arm = if l.moment { self.ref_length } else { 1.0 };
+            info.load_scale = info.load_scale.max(safe_norm(&f) / arm);
             let d = &self.node_dofs[l.node];
             if l.moment {
                 // Global moment m enters the material equations as −Rᵀm; its derivative

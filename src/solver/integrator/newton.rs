@@ -119,7 +119,10 @@ impl Integrator {
                 tangent,
                 Some(&self.tmap),
             );
-            fref = self.sys.ref_force.max(info.force_scale).max(1e-30);
+            // The forces in play now: the loads at t + h and the elements' own forces, not
+            // the largest load of the whole run (a pulse long over, or a huge load, would
+            // make any residual look small: issue 28).
+            fref = info.load_scale.max(info.force_scale).max(1e-30);
             let rn = self.sys.rhs[..nn]
                 .iter()
                 .fold(0.0f64, |m, v| nan_max(m, v.abs()));
@@ -140,7 +143,9 @@ impl Integrator {
             let fscale = fref.max(floor / self.newton.tol_residual);
             let rel = rn.max(cf) / fscale;
             history.push(rel);
-            if !rel.is_finite() || !cn.is_finite() {
+            // A reference that is not finite (a force beyond f64) would make every
+            // residual relative zero: that is a non-finite solution, not convergence.
+            if !rel.is_finite() || !cn.is_finite() || !fscale.is_finite() {
                 return Err(self.failure(h, FailureReason::NotFinite, history, fref));
             }
             // After a solve with a kept matrix the iterate's error is ~ρ/(1−ρ) of the last
@@ -166,6 +171,24 @@ impl Integrator {
                 && (iter == 0 || last_inc <= self.newton.tol_increment)
                 && polished;
             if converged {
+                // A converged state must not hold energy the step cannot pay for.
+                if self.dynamic
+                    && let Some(j) = crate::solver::energy_guard::check(
+                        &self.sys,
+                        &self.nodes,
+                        &self.trial,
+                        self.t,
+                        h,
+                        self.residual_floor * self.sys.ref_length,
+                    )
+                {
+                    return Err(self.failure(
+                        h,
+                        FailureReason::EnergyJump(Box::new(j)),
+                        history,
+                        fref,
+                    ));
+                }
                 if self.dynamic
                     && let Some(a) = self.adaptive.clone()
                 {
