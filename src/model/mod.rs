@@ -481,7 +481,10 @@ impl Model {
             }
             Selection::All | Selection::Default => (0..self.nodes.len()).collect(),
             Selection::None => Vec::new(),
-            Selection::List(l) => l.iter().filter_map(|id| self.nodes.get_index_of(id)).collect(),
+            Selection::List(l) => l
+                .iter()
+                .filter_map(|id| self.nodes.get_index_of(id))
+                .collect(),
         }
     }
 
