@@ -67,6 +67,9 @@ enum Ref {
     Raw(u64),
 }
 
+/// The OUTPUT card: nodes, elements, every, directory, VTK.
+type OutputCanon = (Selection<Ref>, Selection<Ref>, u32, Option<String>, bool);
+
 #[derive(Debug, Clone, PartialEq)]
 struct Canon {
     key_nodes: Vec<(Vector3<f64>, Fixity)>,
@@ -76,7 +79,7 @@ struct Canon {
     gravity: Option<Vector3<f64>>,
     initial: Vec<(usize, Vector3<f64>, Vector3<f64>)>,
     analysis: Analysis,
-    output: Option<(Selection<Ref>, Selection<Ref>, u32, Option<String>, bool)>,
+    output: Option<OutputCanon>,
 }
 
 fn is_beam(e: &Element) -> bool {
@@ -197,7 +200,7 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
             section,
             axis2: *axis2,
             arc: *arc,
-            mesh: (!has(Diff::Mesh)).then(|| (chain.len(), orders)),
+            mesh: (!has(Diff::Mesh)).then_some((chain.len(), orders)),
         });
     }
 

@@ -73,9 +73,10 @@ impl Drop for TempDir {
 /// ways that point elsewhere. The library and the binary are built in the same profile and
 /// with the same features as this test, so `mecano::failpoint::ENABLED` speaks for both.
 pub fn require_failpoints() {
-    assert!(
-        mecano::failpoint::ENABLED,
-        "this test stops runs with MECANO_FAILPOINT, which this build does not have: \
-         run it with debug assertions (`cargo test`) or `--features failpoints`"
-    );
+    if !mecano::failpoint::ENABLED {
+        panic!(
+            "this test stops runs with MECANO_FAILPOINT, which this build does not have: \
+             run it with debug assertions (`cargo test`) or `--features failpoints`"
+        );
+    }
 }
