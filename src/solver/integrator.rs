@@ -131,6 +131,44 @@ pub struct Integrator {
     /// Newton residual history of the step under way (kept between steps so that a
     /// successful step allocates nothing; handed to the [`Failure`] of a failed one).
     history: Vec<f64>,
+    /// Buffers of [`Integrator::consistent_accelerations`], kept so that the restarts of
+    /// the accelerations at a contact's events allocate nothing (issue 27 §1d).
+    acc: AccelerationScratch,
+}
+
+/// Work vectors of the consistent-acceleration solve: sized with the integrator, reused.
+#[derive(Debug, Default)]
+struct AccelerationScratch {
+    /// A zero velocity-correction vector (n equations).
+    zero: Vec<f64>,
+    /// The matrix values of the stiffness-and-constraint assembly.
+    kb: Vec<f64>,
+    /// Right-hand side, then solution `[v̇; λ]`.
+    rhs: Vec<f64>,
+    /// `Ḃ v` per constraint equation.
+    bdot_v: Vec<f64>,
+    /// Constraint residuals at the state and at `q exp(+εv)`.
+    r0: Vec<f64>,
+    rp: Vec<f64>,
+    /// The nodes moved along their velocities by ±ε.
+    plus: Vec<NodeState>,
+    minus: Vec<NodeState>,
+}
+
+impl AccelerationScratch {
+    /// Buffers for `n` equations of which `n_c` are constraints, and `nodes` nodes.
+    fn sized(n: usize, n_c: usize, nodes: usize) -> Self {
+        AccelerationScratch {
+            zero: vec![0.0; n],
+            kb: Vec::new(),
+            rhs: Vec::with_capacity(n),
+            bdot_v: Vec::with_capacity(n_c),
+            r0: Vec::with_capacity(n_c),
+            rp: Vec::with_capacity(n_c),
+            plus: Vec::with_capacity(nodes),
+            minus: Vec::with_capacity(nodes),
+        }
+    }
 }
 
 /// Outcome of one accepted step.
@@ -161,6 +199,7 @@ impl Integrator {
             u: vec![[Vector3::zeros(); 2]; nn],
             tmap: vec![nalgebra::Matrix3::identity(); nn],
             history: Vec::with_capacity(newton.max_iterations as usize + 1),
+            acc: AccelerationScratch::sized(n, n - sys.n_node_eq, nn),
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -179,6 +218,16 @@ impl Integrator {
             event_floor: 0.0,
             abort: None,
             sys,
+        }
+    }
+
+    /// Gives back the residual history of a refused attempt (a [`Failure`] the run loop
+    /// recovers from by cutting the step), so that the next attempt's Newton loop reuses its
+    /// storage instead of growing a new one (no allocation through an impact: issue 27 §1d).
+    pub fn recycle_history(&mut self, mut history: Vec<f64>) {
+        if history.capacity() > self.history.capacity() {
+            history.clear();
+            self.history = history;
         }
     }
 

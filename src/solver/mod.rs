@@ -412,9 +412,11 @@ pub fn run_from(
             }
             Err(Failure {
                 reason: FailureReason::StepRefused(h_ok),
+                residual_history,
                 ..
             }) => {
                 // An element (e.g. a contact at an impact) asks for a shorter step.
+                integ.recycle_history(residual_history);
                 integ.stats.rejected_steps += 1;
                 retry = Some(h_ok.max(hmin).min(h_try));
             }
@@ -424,6 +426,8 @@ pub fn run_from(
                 h = h_try / 2.0;
                 if h < hmin * (1.0 - 1e-12) {
                     failure = Some(f);
+                } else {
+                    integ.recycle_history(f.residual_history);
                 }
             }
         }

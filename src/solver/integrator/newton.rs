@@ -34,19 +34,28 @@ impl Integrator {
                 worst = i;
             }
         }
+        // A step an element refuses (a contact's event ahead) is routine, not a diagnosis:
+        // no worst equation or element messages are formatted for it (no allocation).
+        let routine = matches!(reason, FailureReason::StepRefused(_));
         Failure {
             time: self.t,
             step: h,
             reason,
             residual_history: history,
-            worst: if self.sys.n_eq() > 0 {
+            worst: if routine {
+                String::new()
+            } else if self.sys.n_eq() > 0 {
                 self.sys.describe(worst)
             } else {
                 "-".into()
             },
             worst_value: wv,
             reference_force: fref,
-            diagnoses: self.diagnoses(),
+            diagnoses: if routine {
+                Box::default()
+            } else {
+                self.diagnoses()
+            },
         }
     }
 

@@ -81,7 +81,12 @@ impl Integrator {
             ..self.context(self.t, 0.0, 1.0)
         };
         let ctx1 = EvalContext { c_a: 1.0, ..ctx0 };
-        let zero = vec![0.0; n];
+        // The work vectors are taken out of `self` for the solve (no allocation once sized)
+        // and put back at its end; a failed solve drops them (they are sized again next time).
+        let mut sc = std::mem::take(&mut self.acc);
+        sc.zero.clear();
+        sc.zero.resize(n, 0.0);
+        let zero = &sc.zero;
         // The residual's inertia terms use the nodes' accelerations: clear them, so that
         // the solution is the acceleration itself, not a correction to it.
         for s in &mut self.nodes {
@@ -95,14 +100,17 @@ impl Integrator {
             constraint_scale: s,
             ..ctx0
         };
-        self.sys.assemble(&ctx_s, &self.nodes, &zero, true);
-        let kb = self.sys.matrix.values.clone();
+        self.sys.assemble(&ctx_s, &self.nodes, zero, true);
+        sc.kb.clear();
+        sc.kb.extend_from_slice(&self.sys.matrix.values);
+        let kb = &sc.kb;
         let ctx_m = EvalContext {
             constraint_scale: s,
             ..ctx1
         };
-        let info = self.sys.assemble(&ctx_m, &self.nodes, &zero, true);
-        let mut rhs: Vec<f64> = self.sys.rhs.iter().map(|r| -r).collect();
+        let info = self.sys.assemble(&ctx_m, &self.nodes, zero, true);
+        sc.rhs.clear();
+        sc.rhs.extend(self.sys.rhs.iter().map(|r| -r));
         for eq in 0..n {
             let a = self.sys.matrix.position_range(eq);
             for p in a {
@@ -119,31 +127,32 @@ impl Integrator {
         let (vmax, wmax) = self.nodes.iter().fold((0.0f64, 0.0f64), |(a, b), s| {
             (a.max(s.v.norm()), b.max(s.w.norm()))
         });
-        let mut bdot_v = vec![0.0; n - nn];
+        sc.bdot_v.clear();
+        sc.bdot_v.resize(n - nn, 0.0);
         if n > nn && (vmax > 0.0 || wmax > 0.0) {
             let eps = (1e-3 * self.sys.ref_length / vmax.max(1e-300)).min(1e-3 / wmax.max(1e-300));
-            let moved = |sign: f64, nodes: &[NodeState]| -> Vec<NodeState> {
-                nodes
-                    .iter()
-                    .map(|s| NodeState {
-                        x: s.x + s.v * (sign * eps),
-                        r: s.r * rotation::exp(&(s.w * (sign * eps))),
-                        ..*s
-                    })
-                    .collect()
+            let moved = |sign: f64, nodes: &[NodeState], out: &mut Vec<NodeState>| {
+                out.clear();
+                out.extend(nodes.iter().map(|s| NodeState {
+                    x: s.x + s.v * (sign * eps),
+                    r: s.r * rotation::exp(&(s.w * (sign * eps))),
+                    ..*s
+                }));
             };
-            let plus = moved(1.0, &self.nodes);
-            let minus = moved(-1.0, &self.nodes);
-            self.sys.assemble(&ctx_s, &self.nodes, &zero, false);
-            let r0: Vec<f64> = self.sys.rhs[nn..].to_vec();
-            self.sys.assemble(&ctx_s, &plus, &zero, false);
-            let rp: Vec<f64> = self.sys.rhs[nn..].to_vec();
-            self.sys.assemble(&ctx_s, &minus, &zero, false);
-            for (k, b) in bdot_v.iter_mut().enumerate() {
-                *b = (rp[k] - 2.0 * r0[k] + self.sys.rhs[nn + k]) / (eps * eps);
+            moved(1.0, &self.nodes, &mut sc.plus);
+            moved(-1.0, &self.nodes, &mut sc.minus);
+            self.sys.assemble(&ctx_s, &self.nodes, &sc.zero, false);
+            sc.r0.clear();
+            sc.r0.extend_from_slice(&self.sys.rhs[nn..]);
+            self.sys.assemble(&ctx_s, &sc.plus, &sc.zero, false);
+            sc.rp.clear();
+            sc.rp.extend_from_slice(&self.sys.rhs[nn..]);
+            self.sys.assemble(&ctx_s, &sc.minus, &sc.zero, false);
+            for (k, b) in sc.bdot_v.iter_mut().enumerate() {
+                *b = (sc.rp[k] - 2.0 * sc.r0[k] + self.sys.rhs[nn + k]) / (eps * eps);
             }
         }
-        for (r, b) in rhs.iter_mut().skip(nn).zip(&bdot_v) {
+        for (r, b) in sc.rhs.iter_mut().skip(nn).zip(&sc.bdot_v) {
             *r = -b;
         }
         self.lu_step = f64::NAN;
@@ -156,7 +165,8 @@ impl Integrator {
             ));
         }
         self.stats.factorizations += 1;
-        let _ = self.sys.matrix.solve(&mut rhs);
+        let _ = self.sys.matrix.solve(&mut sc.rhs);
+        let rhs = &sc.rhs;
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(self.failure(
                 0.0,
@@ -180,6 +190,7 @@ impl Integrator {
             }
         }
         self.lambda[nn..n].copy_from_slice(&rhs[nn..n]);
+        self.acc = sc;
         Ok(())
     }
 }
