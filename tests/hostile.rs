@@ -4,6 +4,8 @@
 //! written with an unvalidated value; a huge field is refused fast with a short message;
 //! model errors point at their card; `sweep` reports failed cases and unknown names.
 
+mod common;
+
 use mecano::deck::{DeckErrorKind as K, DeckErrors, ECHO_CHARS, limits, load_deck, parse_deck};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -15,11 +17,9 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mecano_hostile_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("tmp dir");
-    d
+/// A scratch directory removed when the test ends, also when it fails ([`common::TempDir`]).
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(&format!("hostile_{name}"))
 }
 
 fn text(o: &Output) -> String {

@@ -4,16 +4,16 @@
 //! and a restart gives the same `histories.nc` byte for byte; an output that cannot be
 //! opened stops the run before its first step with exit 2.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::{Command, Output};
 
 const BIN: &str = env!("CARGO_BIN_EXE_mecano-rs");
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mecano_large_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch directory removed when the test ends, also when it fails ([`common::TempDir`]).
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(&format!("large_{name}"))
 }
 
 fn text(o: &Output) -> String {
@@ -34,10 +34,13 @@ fn cantilever(n: u32, end: f64, output: &str) -> String {
     )
 }
 
+/// The files a run wrote for its user: its bookkeeping (`.mecano-lock`, `.mecano-manifest`,
+/// README "What a run does to its output directory") is left out.
 fn files(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with(".mecano-"))
         .collect();
     v.sort();
     v
@@ -211,9 +214,20 @@ fn output_that_cannot_be_opened_stops_before_the_first_step_with_exit_2() {
     let d = tmp("blocked");
     let deck = d.join("deck.dat");
     std::fs::write(&deck, cantilever(4, 1e-4, "OUTPUT NODES 2")).unwrap();
-    // The output directory's place is taken by a file.
+    // The output directory's place is taken by a file: refused before anything is built.
     let out = d.join("out");
     std::fs::write(&out, "not a directory").unwrap();
+    let o = run(&deck, &out, None);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("is not a directory"),
+        "the cause is named: {}",
+        text(&o)
+    );
+    // The directory is usable but a history file cannot be created (a directory holds its
+    // name): the writer's own failure, before the first step.
+    let out = d.join("out2");
+    std::fs::create_dir_all(out.join("node_2.csv")).unwrap();
     let o = run(&deck, &out, None);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(

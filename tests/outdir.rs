@@ -3,6 +3,8 @@
 //! releases when its holder dies); a new run removes the files of the previous run there
 //! (its manifest) and refuses files of anyone else unless `--force`.
 
+mod common;
+
 use std::fs::{self, File, OpenOptions};
 use std::os::fd::AsRawFd;
 use std::path::{Path, PathBuf};
@@ -14,11 +16,9 @@ fn bin() -> Command {
     c
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mecano_outdir_{}_{name}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch directory removed when the test ends, also when it fails ([`common::TempDir`]).
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(&format!("outdir_{name}"))
 }
 
 fn text(o: &Output) -> String {

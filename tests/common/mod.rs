@@ -61,6 +61,20 @@ impl TempDir {
     }
 }
 
+/// A `TempDir` stands where a path is asked for (`&d`, `d.join(..)`, `fs::…(&d)`).
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<Path> for TempDir {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
 impl Drop for TempDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.path);
