@@ -14,7 +14,6 @@
 
 pub mod collect;
 pub mod figures;
-pub mod names;
 pub mod plan;
 pub mod quantity;
 pub mod runner;

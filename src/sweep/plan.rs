@@ -316,7 +316,7 @@ impl Plan {
             deck_hash,
         };
         plan.cases = plan.generate().map_err(|m| bad(path, m))?;
-        super::names::check(text, path, &plan)?;
+        names::check(text, path, &plan)?;
         Ok(plan)
     }
 }
@@ -416,6 +416,7 @@ fn variation(p: &ParamFile) -> Result<Variation, String> {
 
 mod cases;
 mod draws;
+mod names;
 mod overlays;
 #[cfg(test)]
 mod tests;

@@ -2,8 +2,8 @@
 //! be a quantity and a parameter of the plan, refused with its line otherwise (they were
 //! ignored: a figure silently lost its reference curve).
 
-use super::SweepError;
-use super::plan::Plan;
+use super::Plan;
+use crate::sweep::SweepError;
 use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
