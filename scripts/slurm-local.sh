@@ -22,6 +22,9 @@ RUN=/run/mecano-slurm
 CONF=/etc/slurm/slurm.conf
 NODE=$(hostname -s)
 MARK="# mecano-rs scripts/slurm-local.sh: a throw-away one-node cluster; this file may be rewritten."
+# The first line the versions of this script before the marker wrote (stop 21-22): a
+# configuration that starts with it is this script's too, left by an older checkout.
+OLD_HEAD="# Written by mecano-rs scripts/slurm-local.sh: a one-node cluster on"
 
 log() { echo "slurm-local: $*" >&2; }
 
@@ -108,7 +111,8 @@ stop_pid() { # pid file, name
 
 # Refuses (exit 3) when a Slurm configuration exists that this script did not write.
 ours_or_none() {
-    if [ -e "$CONF" ] && ! grep -qxF "$MARK" "$CONF"; then
+    if [ -e "$CONF" ] && ! grep -qxF "$MARK" "$CONF" \
+        && ! head -n 1 "$CONF" | grep -qF "$OLD_HEAD"; then
         log "$CONF exists and was not written by this script: refusing to touch this host's Slurm"
         exit 3
     fi
