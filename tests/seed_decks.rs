@@ -327,6 +327,8 @@ const DERIVED: &[(&str, &str, &[Diff])] = &[
     // The triangle of Fig. 2 replaced by a haversine pulse (the torque, the only nodal load: load 0).
     ("pendulum_haversine.dat", "pendulum.dat", &[LoadFunction(0)]),
     ("pendulum_short.dat", "pendulum.dat", &[End]),
+    // To 20.8 s, node 23 only (tests/energy_guard_run.rs).
+    ("pendulum_grazing.dat", "pendulum.dat", &[End, Output]),
     // At its PARAMETERS' values.
     ("pendulum_sweep.dat", "pendulum.dat", &[Output]),
 ];
