@@ -100,6 +100,34 @@ fn interpolate(rows: &[Vec<f64>], k: &mut usize, t: f64, c: usize) -> Option<f64
     Some(a[c] + s * (b[c] - a[c]))
 }
 
+impl ColumnReport {
+    /// The report of a column: its largest difference, the largest per time window
+    /// (`wins[w]` over `[w·window, (w+1)·window)`), and its judgement against `tolerance`.
+    pub(super) fn new(
+        column: String,
+        max: Option<Extreme>,
+        wins: &[Option<f64>],
+        window: f64,
+        tolerance: Option<f64>,
+    ) -> Self {
+        ColumnReport {
+            column,
+            max,
+            windows: wins
+                .iter()
+                .enumerate()
+                .map(|(w, m)| Window {
+                    from: w as f64 * window,
+                    to: (w + 1) as f64 * window,
+                    max_abs_diff: *m,
+                })
+                .collect(),
+            tolerance,
+            pass: tolerance.map(|tv| max.is_none_or(|m| m.max_abs_diff <= tv)),
+        }
+    }
+}
+
 /// Compares two histories on the chosen columns (names present in both).
 pub fn compare_histories(
     file: &str,
@@ -160,23 +188,13 @@ pub fn compare_histories(
             compared = cmp_rows;
             outside = out_rows;
         }
-        let tolerance = tol.of(name);
-        let pass = tolerance.map(|tv| max.is_none_or(|m| m.max_abs_diff <= tv));
-        out.push(ColumnReport {
-            column: name.clone(),
+        out.push(ColumnReport::new(
+            name.clone(),
             max,
-            windows: wins
-                .iter()
-                .enumerate()
-                .map(|(w, m)| Window {
-                    from: w as f64 * window,
-                    to: (w + 1) as f64 * window,
-                    max_abs_diff: *m,
-                })
-                .collect(),
-            tolerance,
-            pass,
-        });
+            &wins,
+            window,
+            tol.of(name),
+        ));
     }
     if by_rotation {
         let tv = tol.of(super::rotation::NAME);

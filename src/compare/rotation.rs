@@ -12,7 +12,7 @@
 //! (the rotation analogue of the linear interpolant of the other columns, of the same order
 //! in the reference's step).
 
-use super::{ColumnReport, Extreme, History, Window};
+use super::{ColumnReport, Extreme, History};
 use crate::rotation::{exp, log};
 use nalgebra::{Matrix3, Vector3};
 
@@ -117,21 +117,7 @@ pub fn compare(
         let w = ((t / window).floor().max(0.0) as usize).min(n_win - 1);
         wins[w] = Some(wins[w].map_or(d, |m: f64| m.max(d)));
     }
-    let report = ColumnReport {
-        column: NAME.to_string(),
-        max,
-        windows: wins
-            .iter()
-            .enumerate()
-            .map(|(w, m)| Window {
-                from: w as f64 * window,
-                to: (w + 1) as f64 * window,
-                max_abs_diff: *m,
-            })
-            .collect(),
-        tolerance,
-        pass: tolerance.map(|tv| max.is_none_or(|m| m.max_abs_diff <= tv)),
-    };
+    let report = ColumnReport::new(NAME.to_string(), max, &wins, window, tolerance);
     (report, compared, outside)
 }
 
