@@ -482,6 +482,12 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         .out_dir
         .clone()
         .unwrap_or_else(|| default_out_dir(path, &model));
+    // `ANALYSIS MODES n`: the modal analysis of `mecano-rs modes DECK --count n` about the
+    // initial state, written into the run's directory (no time run, no checkpoint).
+    if let Some(n) = model.modes {
+        let about = crate::modes::cli::About::Initial;
+        return crate::modes::cli::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
+    }
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);
     match start_session(

@@ -340,3 +340,53 @@ fn four_bar_mechanism_has_one_mode_and_check_reports_the_step() {
         "{text}"
     );
 }
+
+/// `ANALYSIS MODES 8` in a deck: running the deck performs the modal analysis of
+/// `mecano-rs modes DECK --count 8` (the same modes.csv, byte for byte, as the cantilever
+/// deck of `ANALYSIS DYNAMIC` asked for 8 modes), `modes` takes the deck's 8 as its
+/// default count, and a count above the free unknowns is refused (exit 2, nothing written).
+#[test]
+fn analysis_modes_deck_runs_the_modal_analysis() {
+    let base = std::env::temp_dir().join(format!("mecano_modes_deck_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    std::fs::create_dir_all(&base).unwrap();
+    let original = std::fs::read_to_string(deck("cantilever_modes.dat")).unwrap();
+    let dynamic = "ANALYSIS DYNAMIC ALPHA 0 STEP 2e-4 END 0.3";
+    assert!(original.contains(dynamic));
+    let p = base.join("cantilever.dat");
+    std::fs::write(&p, original.replace(dynamic, "ANALYSIS MODES 8")).unwrap();
+    let (p, a, b, c) = (
+        p.to_str().unwrap(),
+        base.join("run"),
+        base.join("modes"),
+        base.join("reference"),
+    );
+    let ok = |o: std::process::Output| {
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    ok(mecano(&[p, "-q", "-o", a.to_str().unwrap()]));
+    ok(mecano(&["modes", p, "-q", "-o", b.to_str().unwrap()]));
+    let d = deck("cantilever_modes.dat");
+    let (d, c) = (d.to_str().unwrap(), c.to_str().unwrap());
+    ok(mecano(&["modes", d, "--count", "8", "-q", "-o", c]));
+    let read = |dir: &Path| std::fs::read_to_string(dir.join("modes.csv")).unwrap();
+    let reference = read(Path::new(c));
+    assert_eq!(reference.lines().count(), 1 + 8);
+    assert_eq!(read(&a), reference);
+    assert_eq!(read(&b), reference);
+    assert!(!a.join("energy.csv").exists(), "no time run");
+    // 72 free unknowns (one beam of order 12: 12 nodes of 6): 100 modes are refused.
+    let q = base.join("too_many.dat");
+    std::fs::write(&q, original.replace(dynamic, "ANALYSIS MODES 100")).unwrap();
+    let o = base.join("too_many");
+    let out = mecano(&[q.to_str().unwrap(), "-q", "-o", o.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("100 modes asked for"));
+    assert!(!o.exists());
+    let _ = std::fs::remove_dir_all(&base);
+}

@@ -281,11 +281,26 @@ pub fn run(args: &ModesArgs) -> u8 {
         (false, Some(t)) => About::At(t),
         (false, None) => About::Initial,
     };
-    let count = args.count.map_or(10, |c| c as usize);
-    let (integ, a) = match analyse_model(&model, about, count) {
+    let count = args.count.or(model.modes).map_or(10, |c| c as usize);
+    let dir = out_dir(args, &model);
+    run_loaded(&args.deck, &model, about, count, &dir, args.quiet)
+}
+
+/// The modal analysis of a loaded model into `dir`: `mecano-rs modes`, and
+/// `mecano-rs DECK` on a deck of `ANALYSIS MODES n` (about the initial state, into the
+/// run's output directory). Returns the exit code.
+pub fn run_loaded(
+    deck: &Path,
+    model: &Model,
+    about: About,
+    count: usize,
+    dir: &Path,
+    quiet: bool,
+) -> u8 {
+    let (integ, a) = match analyse_model(model, about, count) {
         Ok(r) => r,
         Err(f) => {
-            eprintln!("error: {}: {}", args.deck.display(), f.message);
+            eprintln!("error: {}: {}", deck.display(), f.message);
             return f.code;
         }
     };
@@ -294,14 +309,13 @@ pub fn run(args: &ModesArgs) -> u8 {
         About::Static => "static equilibrium".to_string(),
         About::At(t) => format!("run to t = {t} s"),
     };
-    let step = deck_step(&model);
-    let summary = output::summary(&a, &args.deck.display().to_string(), &state, integ.t, step);
-    let dir = out_dir(args, &model);
-    if let Err(e) = output::write_all(&dir, &a, &integ.sys, &shape_nodes(&model), &summary) {
+    let step = deck_step(model);
+    let summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
+    if let Err(e) = output::write_all(dir, &a, &integ.sys, &shape_nodes(model), &summary) {
         eprintln!("error: writing {}: {e}", dir.display());
         return EXIT_FAILED;
     }
-    if !args.quiet {
+    if !quiet {
         let mut out = std::io::stdout().lock();
         print_table(&mut out, &a, step);
         let _ = writeln!(out, "written: {}", dir.display());
