@@ -363,6 +363,11 @@ fn start_session(
         )
     })?;
     writer.refine = plan.as_ref().map_or(1, |p| p.deck.refine);
+    if let Some(v) = crate::modes::run_summary::block(model) {
+        writer
+            .notes
+            .insert(crate::modes::run_summary::KEY.into(), v);
+    }
     if every_step {
         writer.every_accepted_step();
     }

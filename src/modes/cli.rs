@@ -91,6 +91,12 @@ impl Observer for Quiet {
 
 /// The integrator at the state the analysis linearises about.
 pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
+    reach_state_with(model, about, true)
+}
+
+/// [`reach_state`], saying on standard error when the initial multipliers are set to zero
+/// only if `warn` (a run's summary block says it in its own words).
+fn reach_state_with(model: &Model, about: About, warn: bool) -> Result<Integrator, Failed> {
     let newton = match &model.analysis {
         Analysis::Dynamic { newton, .. } | Analysis::Static { newton, .. } => newton.clone(),
     };
@@ -122,9 +128,11 @@ pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
             let crate::solver::FailureReason::Singular(why) = &f.reason else {
                 return Err(failed(format!("the initial state: {f}")));
             };
-            eprintln!(
-                "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
-            );
+            if warn {
+                eprintln!(
+                    "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
+                );
+            }
             integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
         }
         return Ok(integ);
@@ -143,7 +151,16 @@ pub fn analyse_model(
     about: About,
     count: usize,
 ) -> Result<(Integrator, ModalAnalysis), Failed> {
-    let integ = reach_state(model, about)?;
+    analyse_model_with(model, about, count, true)
+}
+
+fn analyse_model_with(
+    model: &Model,
+    about: About,
+    count: usize,
+    warn: bool,
+) -> Result<(Integrator, ModalAnalysis), Failed> {
+    let integ = reach_state_with(model, about, warn)?;
     let groups: Vec<&str> = model.elements.values().map(|e| e.kind.keyword()).collect();
     let a = super::analyse(
         &integ.sys,
@@ -229,18 +246,32 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
         );
         return;
     }
-    match analyse_model(model, About::Initial, 1) {
-        Ok((_, probe)) => {
-            let n = (probe.rigid_modes + 5).min(probe.finite_modes);
-            if let Ok((_, a)) = analyse_model(model, About::Initial, n) {
-                let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
-                print_table(out, &a, deck_step(model));
-            }
+    match lowest_about_initial(model, 5, true) {
+        Ok(a) => {
+            let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
+            print_table(out, &a, deck_step(model));
         }
         Err(f) => {
             let _ = writeln!(out, "modes:       not computed ({})", f.message);
         }
     }
+}
+
+/// The rigid modes and the lowest `elastic` others about the initial state (fewer when the
+/// model has fewer): a first solve counts the rigid modes, a second one keeps that many
+/// more. `warn`: as [`reach_state`]'s.
+pub fn lowest_about_initial(
+    model: &Model,
+    elastic: usize,
+    warn: bool,
+) -> Result<ModalAnalysis, Failed> {
+    let (_, probe) = analyse_model_with(model, About::Initial, 1, warn)?;
+    // A state-space solve (gyroscopic, damped) finds up to twice the free unknowns'
+    // eigenvalues; at most `free_unknowns` modes may be asked for.
+    let n = (probe.rigid_modes + elastic)
+        .min(probe.finite_modes)
+        .min(probe.free_unknowns);
+    Ok(analyse_model_with(model, About::Initial, n, warn)?.1)
 }
 
 fn out_dir(args: &ModesArgs, model: &Model) -> PathBuf {
