@@ -363,7 +363,7 @@ fn start_session(
         )
     })?;
     writer.refine = plan.as_ref().map_or(1, |p| p.deck.refine);
-    if let Some(v) = crate::modes::run_summary::block(model) {
+    if let Some(v) = crate::modes::run_summary::block(model, integ.sys.n_node_eq) {
         writer
             .notes
             .insert(crate::modes::run_summary::KEY.into(), v);

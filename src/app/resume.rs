@@ -174,7 +174,7 @@ pub fn resume_run(
     };
     writer.refine = ck.deck.refine;
     // The same block as the fresh run's (it depends on the model alone).
-    if let Some(v) = crate::modes::run_summary::block(&model) {
+    if let Some(v) = crate::modes::run_summary::block(&model, integ.sys.n_node_eq) {
         writer
             .notes
             .insert(crate::modes::run_summary::KEY.into(), v);

@@ -258,14 +258,24 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
 }
 
 /// The rigid modes and the lowest `elastic` others about the initial state (fewer when the
-/// model has fewer): a first solve counts the rigid modes, a second one keeps that many
-/// more. `warn`: as [`reach_state`]'s.
+/// model has fewer). One dense solve in the usual case (room for six rigid motions); a
+/// model with fewer free unknowns or more rigid motions takes a second one, sized by the
+/// first. `warn`: as [`reach_state`]'s.
 pub fn lowest_about_initial(
     model: &Model,
     elastic: usize,
     warn: bool,
 ) -> Result<ModalAnalysis, Failed> {
-    let (_, probe) = analyse_model_with(model, About::Initial, 1, warn)?;
+    let guess = elastic + 6;
+    let probe = match analyse_model_with(model, About::Initial, guess, warn) {
+        Ok((_, mut a)) if a.rigid_modes + elastic <= guess => {
+            // Rigid modes come first, then the others by frequency.
+            a.modes.truncate(a.rigid_modes + elastic);
+            return Ok(a);
+        }
+        Ok((_, a)) => a,
+        Err(_) => analyse_model_with(model, About::Initial, 1, warn)?.1,
+    };
     // A state-space solve (gyroscopic, damped) finds up to twice the free unknowns'
     // eigenvalues; at most `free_unknowns` modes may be asked for.
     let n = (probe.rigid_modes + elastic)

@@ -19,15 +19,15 @@ pub const LOWEST_ELASTIC: usize = 5;
 /// The `summary.json` key of the block.
 pub const KEY: &str = "step_resolution";
 
-/// The block for `model`: `None` when its analysis is not dynamic; otherwise the table
-/// (`modes`: one row per elastic mode, lowest first, then the mesh's highest frequency),
-/// or `{"computed": false, "reason": …}` when it is not cheap or cannot be computed.
-pub fn block(model: &Model) -> Option<serde_json::Value> {
+/// The block for `model` of `unknowns` nodal unknowns (its system's, known to the run):
+/// `None` when its analysis is not dynamic; otherwise the table (`modes`: one row per
+/// elastic mode, lowest first, then the mesh's highest frequency), or
+/// `{"computed": false, "reason": …}` when it is not cheap or cannot be computed.
+pub fn block(model: &Model, unknowns: usize) -> Option<serde_json::Value> {
     let step = deck_step(model)?;
-    let not_computed = |reason: String| serde_json::json!({ "computed": false, "reason": format!("not computed: {reason}") });
-    let unknowns = match crate::solver::prepare(model) {
-        Ok(integ) => integ.sys.n_node_eq,
-        Err(e) => return Some(not_computed(e.to_string())),
+    let not_computed = |reason: String| {
+        let reason = format!("not computed: {reason}");
+        serde_json::json!({ "computed": false, "reason": reason })
     };
     if unknowns > CHECK_MAX_UNKNOWNS {
         return Some(not_computed(format!(
@@ -59,7 +59,10 @@ pub fn study_lines(model: &Model, steps: &[f64], out: &mut dyn std::io::Write) {
     let Some(deck) = deck_step(model) else {
         return;
     };
-    let Some(block) = block(model) else {
+    let Ok(integ) = crate::solver::prepare(model) else {
+        return;
+    };
+    let Some(block) = block(model, integ.sys.n_node_eq) else {
         return;
     };
     if block["computed"] != true {
