@@ -363,6 +363,11 @@ fn start_session(
         )
     })?;
     writer.refine = plan.as_ref().map_or(1, |p| p.deck.refine);
+    if let Some(v) = crate::modes::run_summary::block(model, integ.sys.n_node_eq) {
+        writer
+            .notes
+            .insert(crate::modes::run_summary::KEY.into(), v);
+    }
     if every_step {
         writer.every_accepted_step();
     }
@@ -482,6 +487,12 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         .out_dir
         .clone()
         .unwrap_or_else(|| default_out_dir(path, &model));
+    // `ANALYSIS MODES n`: the modal analysis of `mecano-rs modes DECK --count n` about the
+    // initial state, written into the run's directory (no time run, no checkpoint).
+    if let Some(n) = model.modes {
+        let about = crate::modes::cli::About::Initial;
+        return crate::modes::cli::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
+    }
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);
     match start_session(

@@ -71,7 +71,7 @@ fn malformed_decks_table() {
             "ANALYSIS QUASI\n".into(),
             1,
             10,
-            "expected DYNAMIC or STATIC",
+            "expected DYNAMIC, STATIC or MODES",
         ),
         (format!("{P}FIX 1 Q\n{A}"), 8, 7, "unexpected `Q`"),
         // malformed or missing numbers, field counts

@@ -202,3 +202,40 @@ this is not read",
         other => panic!("{other:?}"),
     }
 }
+
+/// `ANALYSIS MODES n` reads to a model asking for n modes, prints back as the same card
+/// (parse ∘ write = id, the text a fixed point); `MODES 0`, a missing count or another
+/// field after it are located errors.
+#[test]
+fn modes_analysis_round_trips() {
+    let deck = "MATERIALS\n 1 E 2.1e11 NU 0.3 RHO 7800\nSECTIONS\n 1 A 9e-4 I2 8.3e-8 I3 8.3e-8 J 4.15e-8\n\
+NODES\n 1 0 0 0 FIX ALL\n 2 1 0 0\nELEMENTS\n 1 BEAM 1 2 MAT 1 SEC 1\nANALYSIS MODES 6\n";
+    let mut first = parse_deck(deck, "modes").expect("parses");
+    assert_eq!(first.modes, Some(6));
+    let text = write_deck(&first);
+    assert!(text.contains("\nANALYSIS MODES 6\n"), "{text}");
+    let mut second = parse_deck(&text, "written").expect("written deck parses");
+    strip_spans(&mut first);
+    strip_spans(&mut second);
+    assert_eq!(first, second);
+    assert_eq!(write_deck(&second), text);
+    // A deck without MODES asks for none.
+    let dynamic = deck.replace("ANALYSIS MODES 6", "ANALYSIS DYNAMIC STEP 1e-3 END 1");
+    assert_eq!(parse_deck(&dynamic, "d").expect("parses").modes, None);
+    for (bad, at) in [
+        ("ANALYSIS MODES 0", "0"),
+        ("ANALYSIS MODES", ""),
+        ("ANALYSIS MODES 3 STEP 1", "STEP"),
+    ] {
+        let text = deck.replace("ANALYSIS MODES 6", bad);
+        let e = parse_deck(&text, "bad").expect_err(bad);
+        let msg = format!("{:?}", miette::Report::new(e));
+        assert!(
+            msg.contains("bad:10:"),
+            "{bad}: not located on its line: {msg}"
+        );
+        if !at.is_empty() {
+            assert!(msg.contains(at), "{bad}: {msg}");
+        }
+    }
+}

@@ -134,6 +134,10 @@ fn the_examples_parse() {
 fn the_examples_run() {
     for (k, b) in examples().iter().enumerate() {
         let mut m = parse_deck(b, "grammar.md example").expect("parses");
+        if let Some(n) = m.modes {
+            modal_example_runs(k, b, n);
+            continue;
+        }
         if let mecano::model::Analysis::Dynamic { step, .. } = m.analysis {
             assert!(m.set_fixed_step(step, 10.0 * step, None));
         }
@@ -152,4 +156,40 @@ fn the_examples_run() {
             "example {k}: non-finite state"
         );
     }
+}
+
+/// An `ANALYSIS MODES n` example: `mecano-rs DECK` performs the modal analysis and writes
+/// `modes.csv` (a header and n rows of finite numbers) into the output directory, and
+/// nothing else of a time run (no energy.csv).
+fn modal_example_runs(k: usize, text: &str, n: u32) {
+    let dir = std::env::temp_dir().join(format!("mecano_grammar_modes_{}_{k}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let deck = dir.join("example.dat");
+    std::fs::write(&deck, text).expect("deck written");
+    let out = dir.join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg(&deck)
+        .arg("-q")
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("mecano-rs runs");
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "example {k}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("modes.csv")).expect("modes.csv written");
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), n as usize, "example {k}: {csv}");
+    assert!(
+        rows.iter()
+            .flat_map(|r| r.split(','))
+            .all(|f| f.parse::<f64>().map_or(true, f64::is_finite)),
+        "example {k}: {csv}"
+    );
+    assert!(out.join("summary.json").exists() && !out.join("energy.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -340,3 +340,147 @@ fn four_bar_mechanism_has_one_mode_and_check_reports_the_step() {
         "{text}"
     );
 }
+
+/// `ANALYSIS MODES 8` in a deck: running the deck performs the modal analysis of
+/// `mecano-rs modes DECK --count 8` (the same modes.csv, byte for byte, as the cantilever
+/// deck of `ANALYSIS DYNAMIC` asked for 8 modes), `modes` takes the deck's 8 as its
+/// default count, and a count above the free unknowns is refused (exit 2, nothing written).
+#[test]
+fn analysis_modes_deck_runs_the_modal_analysis() {
+    let base = std::env::temp_dir().join(format!("mecano_modes_deck_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    std::fs::create_dir_all(&base).unwrap();
+    let original = std::fs::read_to_string(deck("cantilever_modes.dat")).unwrap();
+    let dynamic = "ANALYSIS DYNAMIC ALPHA 0 STEP 2e-4 END 0.3";
+    assert!(original.contains(dynamic));
+    let p = base.join("cantilever.dat");
+    std::fs::write(&p, original.replace(dynamic, "ANALYSIS MODES 8")).unwrap();
+    let (p, a, b, c) = (
+        p.to_str().unwrap(),
+        base.join("run"),
+        base.join("modes"),
+        base.join("reference"),
+    );
+    let ok = |o: std::process::Output| {
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    ok(mecano(&[p, "-q", "-o", a.to_str().unwrap()]));
+    ok(mecano(&["modes", p, "-q", "-o", b.to_str().unwrap()]));
+    let d = deck("cantilever_modes.dat");
+    let (d, c) = (d.to_str().unwrap(), c.to_str().unwrap());
+    ok(mecano(&["modes", d, "--count", "8", "-q", "-o", c]));
+    let read = |dir: &Path| std::fs::read_to_string(dir.join("modes.csv")).unwrap();
+    let reference = read(Path::new(c));
+    assert_eq!(reference.lines().count(), 1 + 8);
+    assert_eq!(read(&a), reference);
+    assert_eq!(read(&b), reference);
+    assert!(!a.join("energy.csv").exists(), "no time run");
+    // 72 free unknowns (one beam of order 12: 12 nodes of 6): 100 modes are refused.
+    let q = base.join("too_many.dat");
+    std::fs::write(&q, original.replace(dynamic, "ANALYSIS MODES 100")).unwrap();
+    let o = base.join("too_many");
+    let out = mecano(&[q.to_str().unwrap(), "-q", "-o", o.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("100 modes asked for"));
+    assert!(!o.exists());
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+/// Every dynamic run's summary.json states what the step resolves: the block holds the
+/// lowest five elastic modes about the initial state (the frequencies of the library's
+/// analysis, to round-off) and the mesh's highest, with `1/(f h)` samples per period and
+/// HHT's closed-form damping and period error at that frequency; a model above the dense
+/// limit says "not computed"; a static run has no block.
+#[test]
+fn dynamic_run_summary_states_what_the_step_resolves() {
+    let base = std::env::temp_dir().join(format!("mecano_modes_summary_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    std::fs::create_dir_all(&base).unwrap();
+    let summary = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+    };
+    let run = |deck: &Path, dir: &Path| {
+        let o = mecano(&[deck.to_str().unwrap(), "-q", "-o", dir.to_str().unwrap()]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    // The cantilever with its tip mass, cut to two steps (the block depends on the model).
+    let text = std::fs::read_to_string(deck("cantilever_modes.dat"))
+        .unwrap()
+        .replace("END 0.3", "END 4e-4");
+    let p = base.join("cantilever.dat");
+    std::fs::write(&p, &text).unwrap();
+    let dir = base.join("cantilever");
+    run(&p, &dir);
+    let block = &summary(&dir)["step_resolution"];
+    assert_eq!(block["computed"], true, "{block}");
+    let (alpha, h) = (0.0, 2e-4);
+    assert_eq!(block["alpha"], alpha);
+    assert_eq!(block["step"], h);
+    let a = modes(&model_from(&text), About::Initial, 5);
+    let rows = block["modes"].as_array().unwrap();
+    assert_eq!(rows.len(), 5 + 1, "five elastic modes and the highest");
+    let highest = block["highest_frequency_hz"].as_f64().unwrap();
+    assert_eq!(rows[5]["frequency_hz"].as_f64().unwrap(), highest);
+    assert!((highest - a.highest_hz).abs() <= 1e-9 * highest);
+    for (r, m) in rows.iter().zip(&a.modes) {
+        let f = r["frequency_hz"].as_f64().unwrap();
+        // The same solve of the same model: equal to round-off (1e-9 relative).
+        assert!(
+            (f - m.natural_hz).abs() <= 1e-9 * f,
+            "{f} vs {}",
+            m.natural_hz
+        );
+    }
+    for r in rows {
+        let f = r["frequency_hz"].as_f64().unwrap();
+        let s = r["samples_per_period"].as_f64().unwrap();
+        assert!((s * f * h - 1.0).abs() < 1e-12, "{r}");
+        // α = 0, the trapezoidal rule: no numerical damping, period error
+        // Ω/(2 atan(Ω/2)) − 1 (closed form; src/modes/hht.rs's test holds it to 1e-11).
+        let w = 2.0 * PI * f * h;
+        let exact = w / (2.0 * (w / 2.0).atan()) - 1.0;
+        assert!(r["hht_damping"].as_f64().unwrap().abs() < 1e-12, "{r}");
+        let e = r["period_error"].as_f64().unwrap();
+        assert!((e - exact).abs() <= 1e-9 * (1.0 + exact), "{e} vs {exact}");
+    }
+    // 301 beams of one free node each: 1806 unknowns, above the dense limit of --check.
+    let long = "MATERIALS\n 1 E 2.1e11 NU 0.3 RHO 7800\nSECTIONS\n 1 A 9e-4 I2 8.3e-8 I3 8.3e-8 J 4.15e-8\n\
+NODES\n 1 0 0 0 FIX ALL\n 2 TO 302 LINE 0.01 0 0 1 0 0\nELEMENTS\n 1 TO 301 BEAM 1 2 MAT 1 SEC 1\n\
+ANALYSIS DYNAMIC STEP 1e-5 END 2e-5\nOUTPUT NODES 302 ELEMENTS NONE\n";
+    let p = base.join("long.dat");
+    std::fs::write(&p, long).unwrap();
+    let dir = base.join("long");
+    run(&p, &dir);
+    let block = &summary(&dir)["step_resolution"];
+    assert_eq!(block["computed"], false, "{block}");
+    assert!(
+        block["reason"]
+            .as_str()
+            .unwrap()
+            .starts_with("not computed: 1806 unknowns")
+    );
+    // A static run: no step, no block.
+    let p = base.join("static.dat");
+    std::fs::write(
+        &p,
+        text.replace(
+            "ANALYSIS DYNAMIC ALPHA 0 STEP 2e-4 END 4e-4",
+            "ANALYSIS STATIC",
+        ),
+    )
+    .unwrap();
+    let dir = base.join("static");
+    run(&p, &dir);
+    assert!(summary(&dir).get("step_resolution").is_none());
+    let _ = std::fs::remove_dir_all(&base);
+}

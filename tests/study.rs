@@ -27,6 +27,15 @@ fn study_reports_order_two_on_the_free_body() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     println!("{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(0));
+    // Beside its errors, what the steps resolve of the modes (issue 24), one line per step
+    // of the ladder (the spinning body's only finite frequency, its gyroscopic one).
+    assert!(stdout.contains("what the steps resolve ("), "{stdout}");
+    for h in ["4.000e-2", "2.000e-2", "1.000e-2", "5.000e-3"] {
+        assert!(
+            stdout.contains(&format!("  h = {h} s  highest")),
+            "{stdout}"
+        );
+    }
     for f in [
         "study.csv",
         "study_windows.csv",

@@ -173,6 +173,12 @@ pub fn resume_run(
         }
     };
     writer.refine = ck.deck.refine;
+    // The same block as the fresh run's (it depends on the model alone).
+    if let Some(v) = crate::modes::run_summary::block(&model, integ.sys.n_node_eq) {
+        writer
+            .notes
+            .insert(crate::modes::run_summary::KEY.into(), v);
+    }
     let vtk = match (model.output.vtk, &ck.vtk) {
         (false, _) => None,
         (true, Some(state)) => match VtkWriter::resume(dir, &model, &integ.sys, state) {

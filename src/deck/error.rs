@@ -31,7 +31,9 @@ pub enum DeckErrorKind {
     #[error("empty deck: no cards found (a deck needs at least an ANALYSIS card)")]
     EmptyDeck,
     /// No ANALYSIS card.
-    #[error("no ANALYSIS card: expected `ANALYSIS DYNAMIC ...` or `ANALYSIS STATIC ...`")]
+    #[error(
+        "no ANALYSIS card: expected `ANALYSIS DYNAMIC ...`, `ANALYSIS STATIC ...` or `ANALYSIS MODES n`"
+    )]
     MissingAnalysis,
     /// A card that may appear once appears again.
     #[error("second {keyword} card: only one is allowed (the first is on line {first_line})")]

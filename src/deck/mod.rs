@@ -293,6 +293,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw("DYNAMIC", "ANALYSIS", "implicit dynamics with HHT"),
     kw("STATIC", "ANALYSIS", "static equilibrium with load steps"),
     kw(
+        "MODES",
+        "ANALYSIS",
+        "modal analysis: the lowest n modes about the initial state",
+    ),
+    kw(
         "ALPHA",
         "ANALYSIS",
         "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",

@@ -268,16 +268,24 @@ pub fn write_deck(model: &Model) -> String {
             );
         }
     }
-    match &model.analysis {
-        Analysis::Dynamic {
-            alpha,
-            step,
-            end,
-            min_step,
-            max_step,
-            adaptive,
-            newton,
-        } => {
+    match (&model.analysis, model.modes) {
+        // `ANALYSIS MODES n` parses to the default static analysis of one step: the card
+        // alone gives the model back.
+        (_, Some(n)) => {
+            let _ = writeln!(s, "ANALYSIS MODES {n}");
+        }
+        (
+            Analysis::Dynamic {
+                alpha,
+                step,
+                end,
+                min_step,
+                max_step,
+                adaptive,
+                newton,
+            },
+            None,
+        ) => {
             let _ = write!(
                 s,
                 "ANALYSIS DYNAMIC ALPHA {alpha:?} STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
@@ -298,7 +306,7 @@ pub fn write_deck(model: &Model) -> String {
                 newton_kind(newton)
             );
         }
-        Analysis::Static { steps, newton } => {
+        (Analysis::Static { steps, newton }, None) => {
             let _ = writeln!(
                 s,
                 "ANALYSIS STATIC STEPS {steps} TOL {:?} TOLINC {:?} MAXIT {} NEWTON {}",

@@ -465,6 +465,12 @@ pub struct Model {
     pub initial: Vec<InitialVelocity>,
     /// The analysis.
     pub analysis: Analysis,
+    /// `ANALYSIS MODES n`: the deck asks for a modal analysis, the lowest `n` modes about
+    /// the initial state (`mecano-rs DECK` runs `mecano-rs modes DECK --count n`;
+    /// docs/modes.md). `analysis` is then the static analysis of one load step with the
+    /// default Newton settings (what `modes --static` solves). `None`: the deck runs its
+    /// `analysis`.
+    pub modes: Option<u32>,
     /// Output requests.
     pub output: OutputRequest,
     /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the

@@ -91,6 +91,12 @@ impl Observer for Quiet {
 
 /// The integrator at the state the analysis linearises about.
 pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
+    reach_state_with(model, about, true)
+}
+
+/// [`reach_state`], saying on standard error when the initial multipliers are set to zero
+/// only if `warn` (a run's summary block says it in its own words).
+fn reach_state_with(model: &Model, about: About, warn: bool) -> Result<Integrator, Failed> {
     let newton = match &model.analysis {
         Analysis::Dynamic { newton, .. } | Analysis::Static { newton, .. } => newton.clone(),
     };
@@ -122,9 +128,11 @@ pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
             let crate::solver::FailureReason::Singular(why) = &f.reason else {
                 return Err(failed(format!("the initial state: {f}")));
             };
-            eprintln!(
-                "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
-            );
+            if warn {
+                eprintln!(
+                    "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
+                );
+            }
             integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
         }
         return Ok(integ);
@@ -143,7 +151,16 @@ pub fn analyse_model(
     about: About,
     count: usize,
 ) -> Result<(Integrator, ModalAnalysis), Failed> {
-    let integ = reach_state(model, about)?;
+    analyse_model_with(model, about, count, true)
+}
+
+fn analyse_model_with(
+    model: &Model,
+    about: About,
+    count: usize,
+    warn: bool,
+) -> Result<(Integrator, ModalAnalysis), Failed> {
+    let integ = reach_state_with(model, about, warn)?;
     let groups: Vec<&str> = model.elements.values().map(|e| e.kind.keyword()).collect();
     let a = super::analyse(
         &integ.sys,
@@ -229,18 +246,42 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
         );
         return;
     }
-    match analyse_model(model, About::Initial, 1) {
-        Ok((_, probe)) => {
-            let n = (probe.rigid_modes + 5).min(probe.finite_modes);
-            if let Ok((_, a)) = analyse_model(model, About::Initial, n) {
-                let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
-                print_table(out, &a, deck_step(model));
-            }
+    match lowest_about_initial(model, 5, true) {
+        Ok(a) => {
+            let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
+            print_table(out, &a, deck_step(model));
         }
         Err(f) => {
             let _ = writeln!(out, "modes:       not computed ({})", f.message);
         }
     }
+}
+
+/// The rigid modes and the lowest `elastic` others about the initial state (fewer when the
+/// model has fewer). One dense solve in the usual case (room for six rigid motions); a
+/// model with fewer free unknowns or more rigid motions takes a second one, sized by the
+/// first. `warn`: as [`reach_state`]'s.
+pub fn lowest_about_initial(
+    model: &Model,
+    elastic: usize,
+    warn: bool,
+) -> Result<ModalAnalysis, Failed> {
+    let guess = elastic + 6;
+    let probe = match analyse_model_with(model, About::Initial, guess, warn) {
+        Ok((_, mut a)) if a.rigid_modes + elastic <= guess => {
+            // Rigid modes come first, then the others by frequency.
+            a.modes.truncate(a.rigid_modes + elastic);
+            return Ok(a);
+        }
+        Ok((_, a)) => a,
+        Err(_) => analyse_model_with(model, About::Initial, 1, warn)?.1,
+    };
+    // A state-space solve (gyroscopic, damped) finds up to twice the free unknowns'
+    // eigenvalues; at most `free_unknowns` modes may be asked for.
+    let n = (probe.rigid_modes + elastic)
+        .min(probe.finite_modes)
+        .min(probe.free_unknowns);
+    Ok(analyse_model_with(model, About::Initial, n, warn)?.1)
 }
 
 fn out_dir(args: &ModesArgs, model: &Model) -> PathBuf {
@@ -281,11 +322,26 @@ pub fn run(args: &ModesArgs) -> u8 {
         (false, Some(t)) => About::At(t),
         (false, None) => About::Initial,
     };
-    let count = args.count.map_or(10, |c| c as usize);
-    let (integ, a) = match analyse_model(&model, about, count) {
+    let count = args.count.or(model.modes).map_or(10, |c| c as usize);
+    let dir = out_dir(args, &model);
+    run_loaded(&args.deck, &model, about, count, &dir, args.quiet)
+}
+
+/// The modal analysis of a loaded model into `dir`: `mecano-rs modes`, and
+/// `mecano-rs DECK` on a deck of `ANALYSIS MODES n` (about the initial state, into the
+/// run's output directory). Returns the exit code.
+pub fn run_loaded(
+    deck: &Path,
+    model: &Model,
+    about: About,
+    count: usize,
+    dir: &Path,
+    quiet: bool,
+) -> u8 {
+    let (integ, a) = match analyse_model(model, about, count) {
         Ok(r) => r,
         Err(f) => {
-            eprintln!("error: {}: {}", args.deck.display(), f.message);
+            eprintln!("error: {}: {}", deck.display(), f.message);
             return f.code;
         }
     };
@@ -294,14 +350,13 @@ pub fn run(args: &ModesArgs) -> u8 {
         About::Static => "static equilibrium".to_string(),
         About::At(t) => format!("run to t = {t} s"),
     };
-    let step = deck_step(&model);
-    let summary = output::summary(&a, &args.deck.display().to_string(), &state, integ.t, step);
-    let dir = out_dir(args, &model);
-    if let Err(e) = output::write_all(&dir, &a, &integ.sys, &shape_nodes(&model), &summary) {
+    let step = deck_step(model);
+    let summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
+    if let Err(e) = output::write_all(dir, &a, &integ.sys, &shape_nodes(model), &summary) {
         eprintln!("error: writing {}: {e}", dir.display());
         return EXIT_FAILED;
     }
-    if !args.quiet {
+    if !quiet {
         let mut out = std::io::stdout().lock();
         print_table(&mut out, &a, step);
         let _ = writeln!(out, "written: {}", dir.display());

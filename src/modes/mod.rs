@@ -16,6 +16,7 @@ pub mod dense;
 pub mod hht;
 pub mod linearise;
 pub mod output;
+pub mod run_summary;
 
 use crate::elements::NodeState;
 use crate::solver::system::System;

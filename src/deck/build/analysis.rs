@@ -108,8 +108,25 @@ impl Builder<'_> {
         let span = card.span();
         let mut c = Cursor::new(card, "ANALYSIS card");
         c.skip();
-        let (kind, _) = c.expect_keyword(&["DYNAMIC", "STATIC"], "DYNAMIC or STATIC")?;
+        let (kind, _) =
+            c.expect_keyword(&["DYNAMIC", "STATIC", "MODES"], "DYNAMIC, STATIC or MODES")?;
         c.ctx = format!("ANALYSIS {kind}");
+        if kind == "MODES" {
+            // `ANALYSIS MODES n`: the lowest n modes about the initial state; the static
+            // analysis of one step is what `mecano-rs modes --static` would solve.
+            let (n, s) = c.uint("MODES (number of modes)")?;
+            if n < 1 {
+                return Err(out_of_range("MODES", "0", ">= 1", s));
+            }
+            c.finish()?;
+            let analysis = Analysis::Static {
+                steps: 1,
+                newton: NewtonSettings::default(),
+            };
+            self.set_analysis(analysis, span)?;
+            self.modes = Some(n);
+            return Ok(());
+        }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
                 "ALPHA", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT",
@@ -230,6 +247,11 @@ impl Builder<'_> {
                 newton,
             }
         };
+        self.set_analysis(analysis, span)
+    }
+
+    /// Records the deck's one ANALYSIS card (a second one is an error at its span).
+    fn set_analysis(&mut self, analysis: Analysis, span: Span) -> R<()> {
         if let Some((_, first)) = self.analysis {
             let first_line = self.line(first);
             return Err(DeckError::new(

@@ -49,6 +49,8 @@ struct Builder<'s> {
     gravity: Option<(Vector3<f64>, Span)>,
     initial: Vec<InitialVelocity>,
     analysis: Option<(Analysis, Span)>,
+    /// `ANALYSIS MODES n`.
+    modes: Option<u32>,
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
@@ -137,6 +139,7 @@ pub(crate) fn build_model(
         gravity: None,
         initial: Vec::new(),
         analysis: None,
+        modes: None,
         output: None,
         divide: Vec::new(),
     };
@@ -215,6 +218,7 @@ pub(crate) fn build_model(
         gravity: b.gravity.map(|g| g.0),
         initial: b.initial,
         analysis,
+        modes: b.modes,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
         parameters,

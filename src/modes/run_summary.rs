@@ -1,0 +1,121 @@
+//! What the step resolves, in every dynamic run's `summary.json` (issue 24 §5): the mesh's
+//! highest frequency and, for the lowest elastic modes about the initial state, the
+//! samples per period at the deck's step, HHT's numerical damping ratio and its period
+//! error (the closed forms of [`super::hht`]; the table `--check` prints).
+//!
+//! Only when cheap: the dense solve is O(n³), so above
+//! [`CHECK_MAX_UNKNOWNS`](super::cli::CHECK_MAX_UNKNOWNS) unknowns (the limit of `--check`)
+//! the block says "not computed". The block depends on the deck's model alone (no clock, no
+//! run state): a resumed run writes the same one, so its summary stays the uninterrupted
+//! run's (tests/restart.rs).
+
+use super::cli::{CHECK_MAX_UNKNOWNS, deck_step, lowest_about_initial};
+use super::output::step_resolution;
+use crate::model::Model;
+
+/// Elastic modes the block reports (with the mesh's highest frequency).
+pub const LOWEST_ELASTIC: usize = 5;
+
+/// The `summary.json` key of the block.
+pub const KEY: &str = "step_resolution";
+
+/// The block for `model` of `unknowns` nodal unknowns (its system's, known to the run):
+/// `None` when its analysis is not dynamic; otherwise the table (`modes`: one row per
+/// elastic mode, lowest first, then the mesh's highest frequency), or
+/// `{"computed": false, "reason": …}` when it is not cheap or cannot be computed.
+pub fn block(model: &Model, unknowns: usize) -> Option<serde_json::Value> {
+    let step = deck_step(model)?;
+    let not_computed = |reason: String| {
+        let reason = format!("not computed: {reason}");
+        serde_json::json!({ "computed": false, "reason": reason })
+    };
+    if unknowns > CHECK_MAX_UNKNOWNS {
+        return Some(not_computed(format!(
+            "{unknowns} unknowns > {CHECK_MAX_UNKNOWNS} (the dense solve's limit, as --check's): use mecano-rs modes --count N"
+        )));
+    }
+    let a = match lowest_about_initial(model, LOWEST_ELASTIC, false) {
+        Ok(a) => a,
+        Err(f) => return Some(not_computed(f.message)),
+    };
+    Some(serde_json::json!({
+        "computed": true,
+        "about": "the initial state (mecano-rs modes)",
+        "alpha": step.alpha,
+        "step": step.h,
+        "free_unknowns": a.free_unknowns,
+        "rigid_modes": a.rigid_modes,
+        "highest_frequency_hz": a.highest_hz,
+        "modes": step_resolution(&a, step),
+        "note": "one row per elastic mode, lowest first; last row: the mesh's highest frequency; period_error null = not resolved",
+    }))
+}
+
+/// The lines `mecano-rs study` prints beside its errors: for each step of its ladder, what
+/// it resolves of the lowest elastic mode and of the mesh's highest frequency about the
+/// initial state (at the deck's α), or why it is not computed (above
+/// [`CHECK_MAX_UNKNOWNS`], as the run's block).
+pub fn study_lines(model: &Model, steps: &[f64], out: &mut dyn std::io::Write) {
+    let Some(deck) = deck_step(model) else {
+        return;
+    };
+    let Ok(integ) = crate::solver::prepare(model) else {
+        return;
+    };
+    let Some(block) = block(model, integ.sys.n_node_eq) else {
+        return;
+    };
+    if block["computed"] != true {
+        let _ = writeln!(
+            out,
+            "what the steps resolve: {}",
+            block["reason"].as_str().unwrap_or("not computed")
+        );
+        return;
+    }
+    let Ok(a) = lowest_about_initial(model, 1, false) else {
+        return;
+    };
+    if a.highest_hz <= 0.0 {
+        let _ = writeln!(
+            out,
+            "what the steps resolve: nothing ({} rigid modes, no elastic one, about the initial state)",
+            a.rigid_modes
+        );
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "what the steps resolve (modes about the initial state, HHT alpha {}; mecano-rs modes): samples per period, HHT damping ratio, period error",
+        deck.alpha
+    );
+    for &h in steps {
+        let rows = step_resolution(
+            &a,
+            super::output::DeckStep {
+                alpha: deck.alpha,
+                h,
+            },
+        );
+        let cells: Vec<String> = rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let what = if i + 1 == rows.len() {
+                    "highest"
+                } else {
+                    "lowest"
+                };
+                format!(
+                    "{what} {:.4e} Hz: {:.3e}, {:.2e}, {}",
+                    r.frequency_hz,
+                    r.samples_per_period,
+                    r.hht_damping,
+                    r.period_error
+                        .map_or("unresolved".into(), |e| format!("{e:.2e}"))
+                )
+            })
+            .collect();
+        let _ = writeln!(out, "  h = {h:.3e} s  {}", cells.join("; "));
+    }
+}
