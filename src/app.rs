@@ -5,6 +5,7 @@
 //! interrupted (SIGINT or SIGTERM: whole rows kept, a checkpoint to go on from with
 //! `mecano-rs resume`).
 
+pub mod modes;
 pub mod outdir;
 mod resume;
 mod session;
@@ -201,7 +202,7 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
             );
             check_output(&mut out, path, &model, &integ.sys);
             // The mesh's highest frequency and what the step resolves (issue 24).
-            crate::modes::cli::check_report(&model, &mut out);
+            modes::check_report(&model, &mut out);
             EXIT_OK
         }
         Err(e) => {
@@ -490,8 +491,8 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
     // `ANALYSIS MODES n`: the modal analysis of `mecano-rs modes DECK --count n` about the
     // initial state, written into the run's directory (no time run, no checkpoint).
     if let Some(n) = model.modes {
-        let about = crate::modes::cli::About::Initial;
-        return crate::modes::cli::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
+        let about = modes::About::Initial;
+        return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
     }
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);

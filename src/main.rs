@@ -96,7 +96,7 @@ restart is refused: no valid checkpoint, a complete run, or a deck whose text di
         after_help = "Exit codes: 0 done; 1 the state could not be reached or the eigen-solve failed; \
 2 bad input (deck errors, --count above the free unknowns, --at outside the deck's time, nothing to vibrate)."
     )]
-    Modes(mecano::modes::cli::ModesArgs),
+    Modes(mecano::app::modes::ModesArgs),
     /// Parameter study: run the cases of a plan (TOML) in parallel, or emit a Slurm job
     /// array, and collect sweep.csv, statistics and figures.
     Sweep(mecano::sweep::SweepArgs),
@@ -110,7 +110,7 @@ fn main() -> ExitCode {
         (Some(Command::Resume(args)), _) => mecano::app::resume(args),
         (Some(Command::Compare(args)), _) => mecano::compare::run(args),
         (Some(Command::Sweep(args)), _) => mecano::sweep::run(args),
-        (Some(Command::Modes(args)), _) => mecano::modes::cli::run(args),
+        (Some(Command::Modes(args)), _) => mecano::app::modes::run(args),
         (None, Some(deck)) if cli.check => mecano::app::check(deck, &cli.set, cli.refine),
         (None, Some(deck)) => mecano::app::run(
             deck,

@@ -1,8 +1,8 @@
 //! Linearised modes (issue 24): against closed forms and an independent
 //! minimal-coordinate model. See docs/modes.md.
 
+use mecano::app::modes::{About, analyse_model, load};
 use mecano::model::Model;
-use mecano::modes::cli::{About, analyse_model, load};
 use mecano::modes::{ModalAnalysis, ModeKind};
 use std::f64::consts::PI;
 use std::path::Path;

@@ -11,7 +11,7 @@
 //! time step resolves of each mode; [`output`] writes `modes.csv`, `modes_shapes.csv`,
 //! `summary.json`; [`cli`] is the `modes` subcommand.
 
-pub mod cli;
+pub mod about;
 pub mod dense;
 pub mod hht;
 pub mod linearise;

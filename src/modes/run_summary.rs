@@ -4,12 +4,12 @@
 //! error (the closed forms of [`super::hht`]; the table `--check` prints).
 //!
 //! Only when cheap: the dense solve is O(n³), so above
-//! [`CHECK_MAX_UNKNOWNS`](super::cli::CHECK_MAX_UNKNOWNS) unknowns (the limit of `--check`)
+//! [`CHECK_MAX_UNKNOWNS`](super::about::CHECK_MAX_UNKNOWNS) unknowns (the limit of `--check`)
 //! the block says "not computed". The block depends on the deck's model alone (no clock, no
 //! run state): a resumed run writes the same one, so its summary stays the uninterrupted
 //! run's (tests/restart.rs).
 
-use super::cli::{CHECK_MAX_UNKNOWNS, deck_step, lowest_about_initial};
+use super::about::{CHECK_MAX_UNKNOWNS, deck_step, lowest_about_initial};
 use super::output::step_resolution;
 use crate::model::Model;
 

@@ -103,7 +103,7 @@ pub fn run(args: &StudyArgs) -> u8 {
         }
     };
     let _ = print_table(&report, &mut io::stdout().lock());
-    if let Ok(m) = crate::modes::cli::load(&args.deck, &[], opts.refine, None) {
+    if let Ok(m) = crate::app::modes::load(&args.deck, &[], opts.refine, None) {
         crate::modes::run_summary::study_lines(&m, &opts.steps, &mut io::stdout().lock());
     }
     for ext in ["svg", "png"] {

@@ -1,0 +1,180 @@
+//! The state a modal analysis linearises about (the initial state, the static equilibrium,
+//! the state a run reaches at a time), and the analyses about it that `--check`, a run's
+//! summary and `mecano-rs modes` share.
+
+use super::output::DeckStep;
+use super::{ModalAnalysis, ModesError};
+use crate::model::{Analysis, Model};
+use crate::solver::{self, Integrator, Observer, Snapshot};
+
+/// Where the linearisation is taken.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum About {
+    /// The initial state (consistent accelerations and multipliers at t = 0).
+    Initial,
+    /// The static equilibrium under the deck's loads.
+    Static,
+    /// The state a dynamic run reaches at this time.
+    At(f64),
+}
+
+/// A failure to reach the state or to solve: bad input (the command exits 2) or a failed
+/// solve or run (1).
+#[derive(Debug)]
+pub struct Failed {
+    /// The deck or the request is at fault (not the solver).
+    pub bad_input: bool,
+    /// Message.
+    pub message: String,
+}
+
+fn bad(message: String) -> Failed {
+    Failed {
+        bad_input: true,
+        message,
+    }
+}
+
+fn failed(message: String) -> Failed {
+    Failed {
+        bad_input: false,
+        message,
+    }
+}
+
+struct Quiet;
+impl Observer for Quiet {
+    fn state(&mut self, _snap: &Snapshot) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The integrator at the state the analysis linearises about.
+pub fn reach_state(model: &Model, about: About) -> Result<Integrator, Failed> {
+    reach_state_with(model, about, true)
+}
+
+/// [`reach_state`], saying on standard error when the initial multipliers are set to zero
+/// only if `warn` (a run's summary block says it in its own words).
+fn reach_state_with(model: &Model, about: About, warn: bool) -> Result<Integrator, Failed> {
+    let newton = match &model.analysis {
+        Analysis::Dynamic { newton, .. } | Analysis::Static { newton, .. } => newton.clone(),
+    };
+    let mut m = model.clone();
+    match about {
+        About::Initial => {}
+        About::Static => m.analysis = Analysis::Static { steps: 1, newton },
+        About::At(t) => match &mut m.analysis {
+            Analysis::Dynamic { end, .. } => {
+                if !(t >= 0.0 && t <= *end) {
+                    return Err(bad(format!(
+                        "--at {t}: outside the deck's time span [0, {}] s",
+                        *end
+                    )));
+                }
+                *end = t;
+            }
+            Analysis::Static { .. } => {
+                return Err(bad("--at needs a deck with ANALYSIS DYNAMIC".into()));
+            }
+        },
+    }
+    let mut integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
+    if about == About::Initial {
+        if let Err(f) = integ.initialize() {
+            // An over-constrained mechanism (the four-bar of hinges) has no unique
+            // multipliers, and runs refuse it; its modes are still defined: linearise
+            // with zero multipliers (exact when the constraints carry no force) and say so.
+            let crate::solver::FailureReason::Singular(why) = &f.reason else {
+                return Err(failed(format!("the initial state: {f}")));
+            };
+            if warn {
+                eprintln!(
+                    "warning: the initial multipliers could not be computed ({why}); linearised with zero constraint forces"
+                );
+            }
+            integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
+        }
+        return Ok(integ);
+    }
+    let report = solver::run_prepared(&m, &mut integ, &mut Quiet)
+        .map_err(|e| failed(format!("reaching the state: {e}")))?;
+    if let Some(f) = report.failure {
+        return Err(failed(format!("reaching the state: {f}")));
+    }
+    Ok(integ)
+}
+
+/// Modal analysis of a model at a state, `count` modes (the library's entry point).
+pub fn analyse_model(
+    model: &Model,
+    about: About,
+    count: usize,
+) -> Result<(Integrator, ModalAnalysis), Failed> {
+    analyse_model_with(model, about, count, true)
+}
+
+fn analyse_model_with(
+    model: &Model,
+    about: About,
+    count: usize,
+    warn: bool,
+) -> Result<(Integrator, ModalAnalysis), Failed> {
+    let integ = reach_state_with(model, about, warn)?;
+    let groups: Vec<&str> = model.elements.values().map(|e| e.kind.keyword()).collect();
+    let a = crate::modes::analyse(
+        &integ.sys,
+        &integ.nodes,
+        &integ.lambda,
+        integ.scale,
+        integ.t,
+        &groups,
+        count,
+    )
+    .map_err(|e| match e {
+        ModesError::Dense(d) => failed(d.to_string()),
+        other => bad(other.to_string()),
+    })?;
+    Ok((integ, a))
+}
+
+/// The deck's step and α when it is dynamic.
+pub fn deck_step(model: &Model) -> Option<DeckStep> {
+    match &model.analysis {
+        Analysis::Dynamic { alpha, step, .. } => Some(DeckStep {
+            alpha: *alpha,
+            h: *step,
+        }),
+        Analysis::Static { .. } => None,
+    }
+}
+
+/// Dense solves are O(n³): `--check` reports modes only up to this many free unknowns.
+pub const CHECK_MAX_UNKNOWNS: usize = 1500;
+
+/// The rigid modes and the lowest `elastic` others about the initial state (fewer when the
+/// model has fewer). One dense solve in the usual case (room for six rigid motions); a
+/// model with fewer free unknowns or more rigid motions takes a second one, sized by the
+/// first. `warn`: as [`reach_state`]'s.
+pub fn lowest_about_initial(
+    model: &Model,
+    elastic: usize,
+    warn: bool,
+) -> Result<ModalAnalysis, Failed> {
+    let guess = elastic + 6;
+    let probe = match analyse_model_with(model, About::Initial, guess, warn) {
+        Ok((_, mut a)) if a.rigid_modes + elastic <= guess => {
+            // Rigid modes come first, then the others by frequency.
+            a.modes.truncate(a.rigid_modes + elastic);
+            return Ok(a);
+        }
+        Ok((_, a)) => a,
+        Err(_) => analyse_model_with(model, About::Initial, 1, warn)?.1,
+    };
+    // A state-space solve (gyroscopic, damped) finds up to twice the free unknowns'
+    // eigenvalues; at most `free_unknowns` modes may be asked for.
+    let n = (probe.rigid_modes + elastic)
+        .min(probe.finite_modes)
+        .min(probe.free_unknowns);
+    Ok(analyse_model_with(model, About::Initial, n, warn)?.1)
+}
