@@ -42,7 +42,7 @@ impl SparseSystem {
             u_diag: f.u_diag.clone(),
             row_fwd: f.row_fwd.clone(),
             col_fwd: f.col_fwd.clone(),
-            a_row: f.a_row.clone(),
+            a_row: f.a_row.iter().map(|&r| r as usize).collect(),
             pivoting_factorizations: self.pivoting_factorizations,
         }
     }
@@ -73,7 +73,8 @@ impl SparseSystem {
                     .chain(&s.u_row)
                     .chain(&s.a_row)
                     .all(|&r| r < n)
-                && s.row_fwd.iter().chain(&s.col_fwd).all(|&r| r < n);
+                && s.row_fwd.iter().chain(&s.col_fwd).all(|&r| r < n)
+                && u32::try_from(n).is_ok();
             if !ok {
                 return bad("the factors do not fit the matrix");
             }
@@ -94,7 +95,9 @@ impl SparseSystem {
         f.u_diag = s.u_diag;
         f.row_fwd = s.row_fwd;
         f.col_fwd = s.col_fwd;
-        f.a_row = s.a_row;
+        // `as u32` cannot truncate valid factors (every row < n ≤ u32::MAX, checked above);
+        // invalid ones are never read.
+        f.a_row = s.a_row.iter().map(|&r| r as u32).collect();
         f.work.clear();
         f.work.resize(n, 0.0);
         f.index_runs();
