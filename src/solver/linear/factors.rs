@@ -14,10 +14,12 @@ pub(super) struct Factors {
     /// A factorisation with pivoting has filled the patterns.
     pub(super) valid: bool,
     pub(super) l_ptr: Vec<usize>,
-    pub(super) l_row: Vec<usize>,
+    /// Row indices in 32 bits (n ≤ u32::MAX is checked where they are made): 0.1 kB per
+    /// unknown less at a million unknowns than `usize`.
+    pub(super) l_row: Vec<u32>,
     pub(super) l_val: Vec<f64>,
     pub(super) u_ptr: Vec<usize>,
-    pub(super) u_row: Vec<usize>,
+    pub(super) u_row: Vec<u32>,
     pub(super) u_val: Vec<f64>,
     pub(super) u_diag: Vec<f64>,
     /// Row perm: `row_fwd[k]` = row of `A` pivoted at step k.
@@ -62,7 +64,7 @@ impl Runs {
     /// Builds the runs if they will be used (mean length at least [`MIN_MEAN_RUN`]); else
     /// frees them: a banded factor's runs are short and would take 24 bytes each for
     /// nothing (0.08 kB per unknown on the beam cantilever of `benches/large.sh`).
-    fn build(&mut self, ptr: &[usize], row: &[usize]) {
+    fn build(&mut self, ptr: &[usize], row: &[u32]) {
         self.ptr = Vec::new();
         self.run = Vec::new();
         self.simd = Simd::detect();
@@ -84,10 +86,12 @@ impl Runs {
         for j in 0..ptr.len() - 1 {
             for k in ptr[j]..ptr[j + 1] {
                 match self.run.last_mut() {
-                    Some((r, o, len)) if k > ptr[j] && row[k] == *r + *len && k == *o + *len => {
+                    Some((r, o, len))
+                        if k > ptr[j] && row[k] as usize == *r + *len && k == *o + *len =>
+                    {
                         *len += 1
                     }
-                    _ => self.run.push((row[k], k, 1)),
+                    _ => self.run.push((row[k] as usize, k, 1)),
                 }
             }
             self.ptr.push(self.run.len());
@@ -166,8 +170,10 @@ impl Factors {
         let u_nnz = u.compute_nnz().saturating_sub(n);
         exact(&mut self.l_ptr, n + 1);
         exact(&mut self.u_ptr, n + 1);
-        exact(&mut self.l_row, l_nnz);
-        exact(&mut self.u_row, u_nnz);
+        self.l_row.clear();
+        self.l_row.reserve_exact(l_nnz);
+        self.u_row.clear();
+        self.u_row.reserve_exact(u_nnz);
         exact_f(&mut self.l_val, l_nnz);
         exact_f(&mut self.u_val, u_nnz);
         exact_f(&mut self.u_diag, n);
@@ -195,7 +201,7 @@ impl Factors {
                     (&mut self.u_row, &mut self.u_val, &mut self.u_ptr)
                 };
                 for &(r, v) in &self.sort {
-                    row.push(r);
+                    row.push(r as u32);
                     val.push(v);
                 }
                 ptr.push(row.len());
@@ -214,7 +220,11 @@ impl Factors {
         // The unchecked indexing of `solve` and `refactor` relies on this.
         self.valid = self.u_diag.len() == n
             && u32::try_from(n).is_ok()
-            && self.l_row.iter().chain(&self.u_row).all(|&r| r < n)
+            && self
+                .l_row
+                .iter()
+                .chain(&self.u_row)
+                .all(|&r| (r as usize) < n)
             && self.a_row.iter().all(|&r| (r as usize) < n);
         self.index_runs();
     }
@@ -262,7 +272,7 @@ impl Factors {
                 x[self.a_row[p] as usize] += values[p];
             }
             for q in self.u_ptr[j]..self.u_ptr[j + 1] {
-                let k = self.u_row[q];
+                let k = self.u_row[q] as usize;
                 let xk = std::mem::take(&mut x[k]);
                 self.u_val[q] = xk;
                 if self.l_runs.used {
@@ -272,14 +282,14 @@ impl Factors {
                 let (a, b) = (self.l_ptr[k], self.l_ptr[k + 1]);
                 for (&i, &l) in self.l_row[a..b].iter().zip(&self.l_val[a..b]) {
                     // SAFETY: `load` checked every stored row index against n = x.len().
-                    unsafe { *x.get_unchecked_mut(i) -= l * xk };
+                    unsafe { *x.get_unchecked_mut(i as usize) -= l * xk };
                 }
             }
             let d = std::mem::take(&mut x[j]);
             let lower = self.l_ptr[j]..self.l_ptr[j + 1];
             let cmax = self.l_row[lower.clone()]
                 .iter()
-                .fold(0.0f64, |m, &i| m.max(x[i].abs()));
+                .fold(0.0f64, |m, &i| m.max(x[i as usize].abs()));
             if !(d.is_normal() && d.abs() >= PIVOT_THRESHOLD * cmax) {
                 x.iter_mut().for_each(|v| *v = 0.0);
                 self.valid = false;
@@ -288,7 +298,7 @@ impl Factors {
             self.u_diag[j] = d;
             let inv = 1.0 / d;
             for r in lower {
-                let i = self.l_row[r];
+                let i = self.l_row[r] as usize;
                 self.l_val[r] = std::mem::take(&mut x[i]) * inv;
             }
         }
@@ -334,7 +344,7 @@ impl Factors {
                 let (a, b) = (self.l_ptr[j], self.l_ptr[j + 1]);
                 for (&i, &l) in self.l_row[a..b].iter().zip(&self.l_val[a..b]) {
                     // SAFETY: `load` checked every stored row index against n = y.len().
-                    unsafe { *y.get_unchecked_mut(i) -= l * yj };
+                    unsafe { *y.get_unchecked_mut(i as usize) -= l * yj };
                 }
             }
         }
@@ -347,7 +357,7 @@ impl Factors {
                 let (a, b) = (self.u_ptr[j], self.u_ptr[j + 1]);
                 for (&i, &u) in self.u_row[a..b].iter().zip(&self.u_val[a..b]) {
                     // SAFETY: as above.
-                    unsafe { *y.get_unchecked_mut(i) -= u * yj };
+                    unsafe { *y.get_unchecked_mut(i as usize) -= u * yj };
                 }
             }
         }

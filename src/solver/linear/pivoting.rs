@@ -41,6 +41,10 @@ impl Factors {
     ) -> Result<(), NoPivot> {
         let n = col_fwd.len();
         self.valid = false;
+        // Row indices are stored in 32 bits.
+        if u32::try_from(n).is_err() {
+            return Err(NoPivot(0));
+        }
         for v in [&mut s.marked, &mut s.xj, &mut s.stack] {
             v.clear();
             v.resize(n, 0);
@@ -91,7 +95,7 @@ impl Factors {
                 }
                 let xi = x[i];
                 for p in self.l_ptr[pi]..self.l_ptr[pi + 1] {
-                    x[self.l_row[p]] -= self.l_val[p] * xi;
+                    x[self.l_row[p] as usize] -= self.l_val[p] * xi;
                 }
             }
             let mut pivot = n;
@@ -108,7 +112,7 @@ impl Factors {
                         pivot_abs = a;
                     }
                 } else {
-                    self.u_row.push(row_inv[i]);
+                    self.u_row.push(row_inv[i] as u32);
                     self.u_val.push(x[i]);
                 }
             }
@@ -130,7 +134,7 @@ impl Factors {
             self.u_ptr.push(self.u_row.len());
             for &i in &s.xj[tail..] {
                 if row_inv[i] == n {
-                    self.l_row.push(i);
+                    self.l_row.push(i as u32);
                     self.l_val.push(x[i] * inv);
                 }
                 x[i] = 0.0;
@@ -139,7 +143,7 @@ impl Factors {
         }
         // Rows of `L` to pivot order, sorted in each column.
         for r in &mut self.l_row {
-            *r = row_inv[*r];
+            *r = row_inv[*r as usize] as u32;
         }
         for j in 0..n {
             let (a, b) = (self.l_ptr[j], self.l_ptr[j + 1]);
@@ -160,7 +164,11 @@ impl Factors {
         // The unchecked indexing of `solve` and `refactor` relies on this.
         self.valid = self.u_diag.len() == n
             && u32::try_from(n).is_ok()
-            && self.l_row.iter().chain(&self.u_row).all(|&r| r < n)
+            && self
+                .l_row
+                .iter()
+                .chain(&self.u_row)
+                .all(|&r| (r as usize) < n)
             && self.a_row.iter().all(|&r| (r as usize) < n);
         self.index_runs();
         Ok(())
@@ -168,12 +176,12 @@ impl Factors {
 }
 
 /// Sorts one column's `(row, value)` pairs by row.
-fn sort_column(rows: &mut [usize], vals: &mut [f64], buf: &mut Vec<(usize, f64)>) {
+fn sort_column(rows: &mut [u32], vals: &mut [f64], buf: &mut Vec<(usize, f64)>) {
     buf.clear();
-    buf.extend(rows.iter().copied().zip(vals.iter().copied()));
+    buf.extend(rows.iter().map(|&r| r as usize).zip(vals.iter().copied()));
     buf.sort_unstable_by_key(|e| e.0);
     for ((r, v), &(br, bv)) in rows.iter_mut().zip(vals.iter_mut()).zip(buf.iter()) {
-        *r = br;
+        *r = br as u32;
         *v = bv;
     }
 }
@@ -187,7 +195,7 @@ fn dfs(
     mark: usize,
     xi: &mut [usize],
     l_ptr: &[usize],
-    l_row: &[usize],
+    l_row: &[u32],
     row_inv: &[usize],
     b: usize,
     stack: &mut [usize],
@@ -210,7 +218,7 @@ fn dfs(
         }
         let start = stack[head - 1];
         for p in start..range.end {
-            let i = l_row[p];
+            let i = l_row[p] as usize;
             if marked[i] == mark {
                 continue;
             }

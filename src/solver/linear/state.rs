@@ -34,10 +34,10 @@ impl SparseSystem {
             factored: self.factored,
             valid: f.valid,
             l_ptr: f.l_ptr.clone(),
-            l_row: f.l_row.clone(),
+            l_row: f.l_row.iter().map(|&r| r as usize).collect(),
             l_val: f.l_val.clone(),
             u_ptr: f.u_ptr.clone(),
-            u_row: f.u_row.clone(),
+            u_row: f.u_row.iter().map(|&r| r as usize).collect(),
             u_val: f.u_val.clone(),
             u_diag: f.u_diag.clone(),
             row_fwd: f.row_fwd.clone(),
@@ -87,10 +87,10 @@ impl SparseSystem {
         let f = &mut self.factors;
         f.valid = s.valid;
         f.l_ptr = s.l_ptr;
-        f.l_row = s.l_row;
+        f.l_row = s.l_row.iter().map(|&r| r as u32).collect();
         f.l_val = s.l_val;
         f.u_ptr = s.u_ptr;
-        f.u_row = s.u_row;
+        f.u_row = s.u_row.iter().map(|&r| r as u32).collect();
         f.u_val = s.u_val;
         f.u_diag = s.u_diag;
         f.row_fwd = s.row_fwd;
