@@ -213,11 +213,16 @@ impl Factors {
         self.col_fwd.extend_from_slice(col_fwd);
         self.a_row.clear();
         self.a_row.reserve_exact(a_rows.len());
-        // `as u32` cannot truncate: `valid` below requires n ≤ u32::MAX.
+        // `as u32` cannot truncate: `finish` requires n ≤ u32::MAX.
         self.a_row.extend(a_rows.iter().map(|&r| row_inv[r] as u32));
         self.work.clear();
         self.work.resize(n, 0.0);
-        // The unchecked indexing of `solve` and `refactor` relies on this.
+        self.finish(n);
+    }
+
+    /// Checks the stored indices against `n` and sets `valid` (the unchecked indexing of
+    /// `solve` and `refactor` relies on it), then groups the rows in runs.
+    pub(super) fn finish(&mut self, n: usize) {
         self.valid = self.u_diag.len() == n
             && u32::try_from(n).is_ok()
             && self

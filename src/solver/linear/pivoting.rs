@@ -158,19 +158,10 @@ impl Factors {
         self.col_fwd.extend_from_slice(col_fwd);
         self.a_row.clear();
         self.a_row.reserve_exact(row_idx.len());
-        // `as u32` cannot truncate: `valid` below requires n ≤ u32::MAX.
+        // `as u32` cannot truncate: n ≤ u32::MAX was checked at the start.
         self.a_row
             .extend(row_idx.iter().map(|&r| row_inv[r] as u32));
-        // The unchecked indexing of `solve` and `refactor` relies on this.
-        self.valid = self.u_diag.len() == n
-            && u32::try_from(n).is_ok()
-            && self
-                .l_row
-                .iter()
-                .chain(&self.u_row)
-                .all(|&r| (r as usize) < n)
-            && self.a_row.iter().all(|&r| (r as usize) < n);
-        self.index_runs();
+        self.finish(n);
         Ok(())
     }
 }
