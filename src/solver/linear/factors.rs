@@ -3,6 +3,7 @@
 //! rows of each column grouped in runs of consecutive rows for vectorised updates.
 
 use super::PIVOT_THRESHOLD;
+#[cfg(test)]
 use faer::sparse::linalg::lu::simplicial::SimplicialLu;
 
 /// The simplicial factors `P A Q = L U` in our own storage (compressed columns, row
@@ -13,18 +14,21 @@ pub(super) struct Factors {
     /// A factorisation with pivoting has filled the patterns.
     pub(super) valid: bool,
     pub(super) l_ptr: Vec<usize>,
-    pub(super) l_row: Vec<usize>,
+    /// Row indices in 32 bits (n ≤ u32::MAX is checked where they are made): 0.1 kB per
+    /// unknown less at a million unknowns than `usize`.
+    pub(super) l_row: Vec<u32>,
     pub(super) l_val: Vec<f64>,
     pub(super) u_ptr: Vec<usize>,
-    pub(super) u_row: Vec<usize>,
+    pub(super) u_row: Vec<u32>,
     pub(super) u_val: Vec<f64>,
     pub(super) u_diag: Vec<f64>,
     /// Row perm: `row_fwd[k]` = row of `A` pivoted at step k.
     pub(super) row_fwd: Vec<usize>,
     /// Column order `Q`: `col_fwd[j]` = column of `A` eliminated at step j.
     pub(super) col_fwd: Vec<usize>,
-    /// Pivot-order row of each stored entry of `A`.
-    pub(super) a_row: Vec<usize>,
+    /// Pivot-order row of each stored entry of `A` (32 bits: the dimension is checked
+    /// against `u32::MAX` in `load`; half the memory of `usize` for nnz(A) entries).
+    pub(super) a_row: Vec<u32>,
     /// Dense work vector (zero between uses).
     pub(super) work: Vec<f64>,
     /// (row, value) buffer for sorting a column.
@@ -57,23 +61,42 @@ pub(super) struct Runs {
 const MIN_MEAN_RUN: usize = 8;
 
 impl Runs {
-    fn build(&mut self, ptr: &[usize], row: &[usize]) {
-        self.ptr.clear();
-        self.run.clear();
+    /// Builds the runs if they will be used (mean length at least [`MIN_MEAN_RUN`]); else
+    /// frees them: a banded factor's runs are short and would take 24 bytes each for
+    /// nothing (0.08 kB per unknown on the beam cantilever of `benches/large.sh`).
+    fn build(&mut self, ptr: &[usize], row: &[u32]) {
+        self.ptr = Vec::new();
+        self.run = Vec::new();
+        self.simd = Simd::detect();
+        let mut count = 0;
+        for j in 0..ptr.len() - 1 {
+            for k in ptr[j]..ptr[j + 1] {
+                if k == ptr[j] || row[k] != row[k - 1] + 1 {
+                    count += 1;
+                }
+            }
+        }
+        self.used = count * MIN_MEAN_RUN <= row.len();
+        if !self.used {
+            return;
+        }
+        self.ptr.reserve_exact(ptr.len());
+        self.run.reserve_exact(count);
         self.ptr.push(0);
         for j in 0..ptr.len() - 1 {
             for k in ptr[j]..ptr[j + 1] {
                 match self.run.last_mut() {
-                    Some((r, o, len)) if k > ptr[j] && row[k] == *r + *len && k == *o + *len => {
+                    Some((r, o, len))
+                        if k > ptr[j] && row[k] as usize == *r + *len && k == *o + *len =>
+                    {
                         *len += 1
                     }
-                    _ => self.run.push((row[k], k, 1)),
+                    _ => self.run.push((row[k] as usize, k, 1)),
                 }
             }
             self.ptr.push(self.run.len());
         }
-        self.used = self.run.len() * MIN_MEAN_RUN <= row.len();
-        self.simd = Simd::detect();
+        debug_assert_eq!(self.run.len(), count);
     }
 
     /// `y[rows of column j] −= vals · yj`, run by run (compiled into each of
@@ -118,7 +141,9 @@ impl Simd {
 }
 
 impl Factors {
-    /// Copies faer's factors (rows unsorted, diagonals included) into sorted storage.
+    /// Copies faer's factors (rows unsorted, diagonals included) into sorted storage (the
+    /// reference of the tests of [`Factors::factor_pivoting`]).
+    #[cfg(test)]
     pub(super) fn load(
         &mut self,
         lu: &SimplicialLu<usize, f64>,
@@ -129,13 +154,29 @@ impl Factors {
     ) {
         let n = row_fwd.len();
         let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
-        self.l_ptr.clear();
+        // Sized exactly (faer's counts less the n diagonals of each factor), not grown by
+        // doubling: at a million unknowns the spare capacity was 0.2 kB per unknown.
+        let exact = |v: &mut Vec<usize>, len: usize| {
+            v.clear();
+            v.shrink_to(len);
+            v.reserve_exact(len);
+        };
+        let exact_f = |v: &mut Vec<f64>, len: usize| {
+            v.clear();
+            v.shrink_to(len);
+            v.reserve_exact(len);
+        };
+        let l_nnz = l.compute_nnz().saturating_sub(n);
+        let u_nnz = u.compute_nnz().saturating_sub(n);
+        exact(&mut self.l_ptr, n + 1);
+        exact(&mut self.u_ptr, n + 1);
         self.l_row.clear();
-        self.l_val.clear();
-        self.u_ptr.clear();
+        self.l_row.reserve_exact(l_nnz);
         self.u_row.clear();
-        self.u_val.clear();
-        self.u_diag.clear();
+        self.u_row.reserve_exact(u_nnz);
+        exact_f(&mut self.l_val, l_nnz);
+        exact_f(&mut self.u_val, u_nnz);
+        exact_f(&mut self.u_diag, n);
         self.l_ptr.push(0);
         self.u_ptr.push(0);
         for j in 0..n {
@@ -160,7 +201,7 @@ impl Factors {
                     (&mut self.u_row, &mut self.u_val, &mut self.u_ptr)
                 };
                 for &(r, v) in &self.sort {
-                    row.push(r);
+                    row.push(r as u32);
                     val.push(v);
                 }
                 ptr.push(row.len());
@@ -171,13 +212,25 @@ impl Factors {
         self.col_fwd.clear();
         self.col_fwd.extend_from_slice(col_fwd);
         self.a_row.clear();
-        self.a_row.extend(a_rows.iter().map(|&r| row_inv[r]));
+        self.a_row.reserve_exact(a_rows.len());
+        // `as u32` cannot truncate: `finish` requires n ≤ u32::MAX.
+        self.a_row.extend(a_rows.iter().map(|&r| row_inv[r] as u32));
         self.work.clear();
         self.work.resize(n, 0.0);
-        // The unchecked indexing of `solve` and `refactor` relies on this.
+        self.finish(n);
+    }
+
+    /// Checks the stored indices against `n` and sets `valid` (the unchecked indexing of
+    /// `solve` and `refactor` relies on it), then groups the rows in runs.
+    pub(super) fn finish(&mut self, n: usize) {
         self.valid = self.u_diag.len() == n
-            && self.l_row.iter().chain(&self.u_row).all(|&r| r < n)
-            && self.a_row.iter().all(|&r| r < n);
+            && u32::try_from(n).is_ok()
+            && self
+                .l_row
+                .iter()
+                .chain(&self.u_row)
+                .all(|&r| (r as usize) < n)
+            && self.a_row.iter().all(|&r| (r as usize) < n);
         self.index_runs();
     }
 
@@ -221,10 +274,10 @@ impl Factors {
         let x = &mut self.work;
         for (j, &pj) in self.col_fwd.iter().enumerate() {
             for p in col_ptr[pj]..col_ptr[pj + 1] {
-                x[self.a_row[p]] += values[p];
+                x[self.a_row[p] as usize] += values[p];
             }
             for q in self.u_ptr[j]..self.u_ptr[j + 1] {
-                let k = self.u_row[q];
+                let k = self.u_row[q] as usize;
                 let xk = std::mem::take(&mut x[k]);
                 self.u_val[q] = xk;
                 if self.l_runs.used {
@@ -234,14 +287,14 @@ impl Factors {
                 let (a, b) = (self.l_ptr[k], self.l_ptr[k + 1]);
                 for (&i, &l) in self.l_row[a..b].iter().zip(&self.l_val[a..b]) {
                     // SAFETY: `load` checked every stored row index against n = x.len().
-                    unsafe { *x.get_unchecked_mut(i) -= l * xk };
+                    unsafe { *x.get_unchecked_mut(i as usize) -= l * xk };
                 }
             }
             let d = std::mem::take(&mut x[j]);
             let lower = self.l_ptr[j]..self.l_ptr[j + 1];
             let cmax = self.l_row[lower.clone()]
                 .iter()
-                .fold(0.0f64, |m, &i| m.max(x[i].abs()));
+                .fold(0.0f64, |m, &i| m.max(x[i as usize].abs()));
             if !(d.is_normal() && d.abs() >= PIVOT_THRESHOLD * cmax) {
                 x.iter_mut().for_each(|v| *v = 0.0);
                 self.valid = false;
@@ -250,7 +303,7 @@ impl Factors {
             self.u_diag[j] = d;
             let inv = 1.0 / d;
             for r in lower {
-                let i = self.l_row[r];
+                let i = self.l_row[r] as usize;
                 self.l_val[r] = std::mem::take(&mut x[i]) * inv;
             }
         }
@@ -296,7 +349,7 @@ impl Factors {
                 let (a, b) = (self.l_ptr[j], self.l_ptr[j + 1]);
                 for (&i, &l) in self.l_row[a..b].iter().zip(&self.l_val[a..b]) {
                     // SAFETY: `load` checked every stored row index against n = y.len().
-                    unsafe { *y.get_unchecked_mut(i) -= l * yj };
+                    unsafe { *y.get_unchecked_mut(i as usize) -= l * yj };
                 }
             }
         }
@@ -309,7 +362,7 @@ impl Factors {
                 let (a, b) = (self.u_ptr[j], self.u_ptr[j + 1]);
                 for (&i, &u) in self.u_row[a..b].iter().zip(&self.u_val[a..b]) {
                     // SAFETY: as above.
-                    unsafe { *y.get_unchecked_mut(i) -= u * yj };
+                    unsafe { *y.get_unchecked_mut(i as usize) -= u * yj };
                 }
             }
         }

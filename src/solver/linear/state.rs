@@ -34,15 +34,15 @@ impl SparseSystem {
             factored: self.factored,
             valid: f.valid,
             l_ptr: f.l_ptr.clone(),
-            l_row: f.l_row.clone(),
+            l_row: f.l_row.iter().map(|&r| r as usize).collect(),
             l_val: f.l_val.clone(),
             u_ptr: f.u_ptr.clone(),
-            u_row: f.u_row.clone(),
+            u_row: f.u_row.iter().map(|&r| r as usize).collect(),
             u_val: f.u_val.clone(),
             u_diag: f.u_diag.clone(),
             row_fwd: f.row_fwd.clone(),
             col_fwd: f.col_fwd.clone(),
-            a_row: f.a_row.clone(),
+            a_row: f.a_row.iter().map(|&r| r as usize).collect(),
             pivoting_factorizations: self.pivoting_factorizations,
         }
     }
@@ -73,7 +73,8 @@ impl SparseSystem {
                     .chain(&s.u_row)
                     .chain(&s.a_row)
                     .all(|&r| r < n)
-                && s.row_fwd.iter().chain(&s.col_fwd).all(|&r| r < n);
+                && s.row_fwd.iter().chain(&s.col_fwd).all(|&r| r < n)
+                && u32::try_from(n).is_ok();
             if !ok {
                 return bad("the factors do not fit the matrix");
             }
@@ -86,15 +87,17 @@ impl SparseSystem {
         let f = &mut self.factors;
         f.valid = s.valid;
         f.l_ptr = s.l_ptr;
-        f.l_row = s.l_row;
+        f.l_row = s.l_row.iter().map(|&r| r as u32).collect();
         f.l_val = s.l_val;
         f.u_ptr = s.u_ptr;
-        f.u_row = s.u_row;
+        f.u_row = s.u_row.iter().map(|&r| r as u32).collect();
         f.u_val = s.u_val;
         f.u_diag = s.u_diag;
         f.row_fwd = s.row_fwd;
         f.col_fwd = s.col_fwd;
-        f.a_row = s.a_row;
+        // `as u32` cannot truncate valid factors (every row < n ≤ u32::MAX, checked above);
+        // invalid ones are never read.
+        f.a_row = s.a_row.iter().map(|&r| r as u32).collect();
         f.work.clear();
         f.work.resize(n, 0.0);
         f.index_runs();
