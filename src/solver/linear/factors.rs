@@ -65,8 +65,8 @@ impl Runs {
     /// frees them: a banded factor's runs are short and would take 24 bytes each for
     /// nothing (0.08 kB per unknown on the beam cantilever of `benches/large.sh`).
     fn build(&mut self, ptr: &[usize], row: &[u32]) {
-        self.ptr = Vec::new();
-        self.run = Vec::new();
+        self.ptr.clear();
+        self.run.clear();
         self.simd = Simd::detect();
         let mut count = 0;
         for j in 0..ptr.len() - 1 {
@@ -78,10 +78,15 @@ impl Runs {
         }
         self.used = count * MIN_MEAN_RUN <= row.len();
         if !self.used {
+            self.ptr = Vec::new();
+            self.run = Vec::new();
             return;
         }
+        // Kept (cleared, not freed) while used: a later factorisation with pivoting (a
+        // contact's restart of the accelerations) rebuilds them without allocating once
+        // they are large enough (tests/alloc.rs, the contact path).
         self.ptr.reserve_exact(ptr.len());
-        self.run.reserve_exact(count);
+        self.run.reserve(count);
         self.ptr.push(0);
         for j in 0..ptr.len() - 1 {
             for k in ptr[j]..ptr[j + 1] {
