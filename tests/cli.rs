@@ -1,10 +1,12 @@
 //! The command line: a deck with errors exits with code 2 and writes nothing.
 
+mod common;
+
 use std::process::Command;
 
 #[test]
 fn a_bad_deck_exits_with_code_2_and_creates_no_output_directory() {
-    let tmp = std::env::temp_dir().join(format!("mecano_cli_{}", std::process::id()));
+    let tmp = common::TempDir::new("cli");
     std::fs::create_dir_all(&tmp).unwrap();
     let deck = tmp.join("bad.dat");
     std::fs::write(

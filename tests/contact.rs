@@ -5,6 +5,8 @@
 //! Initial velocities are set with `Integrator::set_velocity` between `solver::prepare` and
 //! `solver::run_prepared` (the decks have no INITIAL section yet).
 
+mod common;
+
 use mecano::model::{ElementKind, Model, NodeId};
 use mecano::solver::{self, Observer, Snapshot};
 use nalgebra::Vector3;
@@ -441,7 +443,7 @@ fn pendulum_strikes_the_floor_within_its_energy() {
 fn histories_keep_regular_instants_through_an_impact() {
     let mut model = load("pendulum.dat");
     assert!(model.set_fixed_step(1e-4, 0.6, None));
-    let dir = std::env::temp_dir().join(format!("mecano_instants_{}", std::process::id()));
+    let dir = common::TempDir::new("instants");
     let _ = std::fs::remove_dir_all(&dir);
     let rep = mecano::app::run_model(&model, "pendulum.dat", &dir, true).expect("run");
     assert!(rep.failure.is_none());

@@ -1,6 +1,8 @@
 //! `grammar.md` documents every keyword the parser accepts, documents nothing the parser
 //! does not accept, and its examples are valid decks.
 
+mod common;
+
 use mecano::deck::{KEYWORDS, parse_deck};
 use std::collections::BTreeSet;
 
@@ -162,7 +164,7 @@ fn the_examples_run() {
 /// `modes.csv` (a header and n rows of finite numbers) into the output directory, and
 /// nothing else of a time run (no energy.csv).
 fn modal_example_runs(k: usize, text: &str, n: u32) {
-    let dir = std::env::temp_dir().join(format!("mecano_grammar_modes_{}_{k}", std::process::id()));
+    let dir = common::TempDir::new(&format!("grammar_modes_{k}"));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
     let deck = dir.join("example.dat");

@@ -1,6 +1,8 @@
 //! Linearised modes (issue 24): against closed forms and an independent
 //! minimal-coordinate model. See docs/modes.md.
 
+mod common;
+
 use mecano::app::modes::{About, analyse_model, load};
 use mecano::model::Model;
 use mecano::modes::{ModalAnalysis, ModeKind};
@@ -233,7 +235,7 @@ fn mecano(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn cli_writes_the_modes_of_the_cantilever() {
-    let dir = std::env::temp_dir().join(format!("mecano_modes_cli_{}", std::process::id()));
+    let dir = common::TempDir::new("modes_cli");
     let _ = std::fs::remove_dir_all(&dir);
     let d = deck("cantilever_modes.dat");
     let out = mecano(&[
@@ -277,7 +279,7 @@ fn cli_writes_the_modes_of_the_cantilever() {
 
 #[test]
 fn bad_requests_exit_2_and_write_nothing() {
-    let base = std::env::temp_dir().join(format!("mecano_modes_bad_{}", std::process::id()));
+    let base = common::TempDir::new("modes_bad");
     let _ = std::fs::remove_dir_all(&base);
     // The four-bar's hinges are redundant (3 of 15 equations): one free unknown.
     let four = deck("four_bar.dat");
@@ -347,7 +349,7 @@ fn four_bar_mechanism_has_one_mode_and_check_reports_the_step() {
 /// default count, and a count above the free unknowns is refused (exit 2, nothing written).
 #[test]
 fn analysis_modes_deck_runs_the_modal_analysis() {
-    let base = std::env::temp_dir().join(format!("mecano_modes_deck_{}", std::process::id()));
+    let base = common::TempDir::new("modes_deck");
     let _ = std::fs::remove_dir_all(&base);
     std::fs::create_dir_all(&base).unwrap();
     let original = std::fs::read_to_string(deck("cantilever_modes.dat")).unwrap();
@@ -398,7 +400,7 @@ fn analysis_modes_deck_runs_the_modal_analysis() {
 /// limit says "not computed"; a static run has no block.
 #[test]
 fn dynamic_run_summary_states_what_the_step_resolves() {
-    let base = std::env::temp_dir().join(format!("mecano_modes_summary_{}", std::process::id()));
+    let base = common::TempDir::new("modes_summary");
     let _ = std::fs::remove_dir_all(&base);
     std::fs::create_dir_all(&base).unwrap();
     let summary = |dir: &Path| -> serde_json::Value {

@@ -1,5 +1,7 @@
 //! `mecano-rs plot`: the three figures from a short real run, and clear errors (exit 2).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -25,11 +27,9 @@ OUTPUT NODES ALL ELEMENTS NONE
 END
 ";
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mecano-plot-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch directory removed when the test ends, also when it fails.
+fn scratch(name: &str) -> common::TempDir {
+    common::TempDir::new(&format!("plot-{name}"))
 }
 
 fn run_deck(dir: &Path) -> PathBuf {

@@ -4,6 +4,8 @@
 //! joints and contacts stay where the user put them, and a refined deck is the same model
 //! — and gives the same motion — as the hand-written finer deck.
 
+mod common;
+
 use mecano::deck::{load_deck, parse_deck, strip_spans, write_deck};
 use mecano::model::{ElementId, ElementKind, Model, NodeId};
 use mecano::output::History;
@@ -231,7 +233,7 @@ fn command_line_refine_check_run_and_outputs() {
         "{text}"
     );
 
-    let tmp = std::env::temp_dir().join(format!("mecano_refine_{}", std::process::id()));
+    let tmp = common::TempDir::new("refine");
     std::fs::create_dir_all(&tmp).expect("tmp");
     let src = std::fs::read_to_string(deck_path("pendulum.dat")).expect("reads");
     let short = src.replace("END 2.0", "END 0.002");

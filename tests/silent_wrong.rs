@@ -3,10 +3,12 @@
 //! without the work to pay for it is refused (the energy guard); every failure writes the
 //! same complete record.
 
+mod common;
+
 use mecano::deck::parse_deck;
 use mecano::output::History;
 use mecano::solver::{self, energy_guard};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 const PENDULUM: &str = include_str!("../decks/pendulum.dat");
@@ -136,11 +138,9 @@ fn the_energy_guard_does_not_refuse_a_resolved_run() {
     assert_eq!(report.stats.rejected_steps, 0, "{:?}", report.stats);
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mecano_silent_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch directory removed when the test ends, also when it fails.
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(&format!("silent_{name}"))
 }
 
 fn summary(dir: &Path) -> serde_json::Value {

@@ -1,6 +1,8 @@
 //! `mecano-rs study`, through the binary, on a deck whose convergence is known in closed
 //! form: the torque-free rigid body (`decks/free_body.dat`), integrated by HHT with α = 0.
 
+mod common;
+
 use std::path::Path;
 
 /// Four fixed steps h = 4e-2 … 5e-3 s and one adaptive run over the 4 s of the deck. The body
@@ -12,7 +14,7 @@ use std::path::Path;
 /// contracts by 4 per halving, the test asks for 2).
 #[test]
 fn study_reports_order_two_on_the_free_body() {
-    let dir = std::env::temp_dir().join(format!("mecano_study_{}", std::process::id()));
+    let dir = common::TempDir::new("study");
     let _ = std::fs::remove_dir_all(&dir);
     let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/free_body.dat");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
@@ -94,7 +96,7 @@ fn study_reports_order_two_on_the_free_body() {
 /// `inf`), and the study exits non-zero since no error can be measured.
 #[test]
 fn study_of_runs_that_stop_reports_them_and_writes_no_non_numbers() {
-    let dir = std::env::temp_dir().join(format!("mecano_study_stop_{}", std::process::id()));
+    let dir = common::TempDir::new("study_stop");
     let _ = std::fs::remove_dir_all(&dir);
     let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/stab_diverge.dat");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
@@ -143,7 +145,7 @@ fn study_of_runs_that_stop_reports_them_and_writes_no_non_numbers() {
 /// converged in both variables, every run is scored, and the files and diagram are written.
 #[test]
 fn space_time_study_separates_second_order_errors_in_space_and_time() {
-    let dir = std::env::temp_dir().join(format!("mecano_spacetime_{}", std::process::id()));
+    let dir = common::TempDir::new("spacetime");
     let _ = std::fs::remove_dir_all(&dir);
     let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/cantilever_smooth_load.dat");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
@@ -231,7 +233,7 @@ fn space_time_study_separates_second_order_errors_in_space_and_time() {
 /// `--order 0` and two levels with the same number of nodes are bad input (exit 2).
 #[test]
 fn order_study_shows_errors_falling_faster_than_mesh_refinement() {
-    let dir = std::env::temp_dir().join(format!("mecano_orderstudy_{}", std::process::id()));
+    let dir = common::TempDir::new("orderstudy");
     let _ = std::fs::remove_dir_all(&dir);
     let deck = Path::new(env!("CARGO_MANIFEST_DIR")).join("decks/cantilever_smooth_load.dat");
     let study = |args: &[&str]| {

@@ -1,6 +1,8 @@
 //! `OUTPUT … VTK`: a short run of the pendulum writes a ParaView series whose `.pvd`
 //! references existing `.vtu` files with one point per node and one line per beam.
 
+mod common;
+
 use mecano::output::vtk::{PVD_NAME, VTK_LINE};
 
 /// The value of attribute `name` in the first tag of `s` that has it.
@@ -29,7 +31,7 @@ fn short_pendulum_run_writes_a_readable_paraview_series() {
         .replace("END 2.0", "END 0.003")
         .replace("EVERY 10", "EVERY 10 VTK");
     assert!(text.contains(" VTK"));
-    let dir = std::env::temp_dir().join(format!("mecano-vtk-{}", std::process::id()));
+    let dir = common::TempDir::new("vtk");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let model = mecano::deck::parse_deck(&text, "pendulum_vtk.dat").expect("deck parses");
