@@ -7,6 +7,7 @@ mod cursor;
 mod elements;
 mod nodes;
 mod properties;
+mod section;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
