@@ -7,6 +7,7 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+mod drive;
 mod function;
 mod ids;
 mod mesh;
@@ -14,6 +15,7 @@ pub mod order;
 mod output;
 mod summary;
 
+pub use drive::{Drive, NodeMotion};
 pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
@@ -212,6 +214,13 @@ pub enum ElementKind {
     Rigid,
     /// Cam–follower contact (first node: cam, second: follower).
     Came(Box<CameData>),
+    /// A prescribed motion of one node (`PRESCRIBED`, [`drive`](self::Drive)).
+    Prescribed {
+        /// What is prescribed.
+        motion: NodeMotion,
+        /// Its value `a f(t)`.
+        drive: Drive,
+    },
 }
 
 impl ElementKind {
@@ -227,6 +236,7 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => "PRISMATIC",
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
+            ElementKind::Prescribed { .. } => "PRESCRIBED",
         }
     }
 
@@ -239,6 +249,7 @@ impl ElementKind {
             ElementKind::Clamp => 6,
             ElementKind::Prismatic { .. } => 5,
             ElementKind::Rigid => 6 * node_count.saturating_sub(1),
+            ElementKind::Prescribed { motion, .. } => motion.equations(),
             _ => 0,
         }
     }
@@ -422,4 +433,7 @@ pub struct Model {
     /// The interior nodes generated for beams of order > 1 (`ORDER p`), by element, along
     /// the axis (see [`order`](self::order)).
     pub order_nodes: IndexMap<ElementId, Vec<NodeId>>,
+    /// Driven joints (`HINGE … DRIVE f`, `PRISMATIC … DRIVE f`), by the joint's number:
+    /// one more constraint each (model/drive.rs).
+    pub drives: IndexMap<ElementId, Drive>,
 }
