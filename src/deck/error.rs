@@ -368,6 +368,14 @@ pub enum DeckErrorKind {
         /// Line of the first definition.
         first_line: usize,
     },
+    /// A driver (a `DRIVE` on a joint, a `PRESCRIBED` element) that cannot be built.
+    #[error("{context}: {reason}")]
+    BadDrive {
+        /// The card (`element 3 (UJOINT)`).
+        context: String,
+        /// What is wrong and what is accepted.
+        reason: String,
+    },
     /// `--set name=value` (or a sweep plan) for a parameter the deck does not define.
     #[error("cannot set parameter `{name}`: the deck does not define it ({known})")]
     UnknownOverride {
@@ -441,6 +449,7 @@ impl DeckError {
             K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
                 "mecano::deck::element"
             }
+            K::BadDrive { .. } => "mecano::deck::drive",
         }
     }
 

@@ -258,6 +258,26 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw("SPHERICAL", "ELEMENTS", "spherical joint"),
     kw("CLAMP", "ELEMENTS", "two nodes welded together"),
     kw("PRISMATIC", "ELEMENTS", "prismatic (sliding) joint"),
+    kw(
+        "DRIVE",
+        "ELEMENTS",
+        "HINGE or PRISMATIC: the angle or travel prescribed as a·f(t) (function number)",
+    ),
+    kw(
+        "AMPLITUDE",
+        "ELEMENTS",
+        "DRIVE or PRESCRIBED: the factor a of a·f(t), rad or m (default 1)",
+    ),
+    kw(
+        "PRESCRIBED",
+        "ELEMENTS",
+        "a node's displacement component (X, Y, Z) or rotation about a fixed axis prescribed as a·f(t)",
+    ),
+    kw(
+        "ROTATION",
+        "ELEMENTS",
+        "PRESCRIBED: the node's rotation about a fixed global axis",
+    ),
     kw("CAME", "ELEMENTS", "cam-follower contact element"),
     kw("CAM", "ELEMENTS", "CAME: the cam's profile (first node)"),
     kw(

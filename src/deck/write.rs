@@ -207,6 +207,24 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 ElementKind::Hinge { axis } | ElementKind::Prismatic { axis } => {
                     let _ = write!(s, " AXIS {}", v3(axis));
+                    if let Some(d) = model.drives.get(&e.id) {
+                        let _ = write!(s, " DRIVE {} AMPLITUDE {:?}", d.function.0, d.amplitude);
+                    }
+                }
+                ElementKind::Prescribed { motion, drive } => {
+                    match motion {
+                        crate::model::NodeMotion::Displacement(i) => {
+                            let _ = write!(s, " {}", ["X", "Y", "Z"][*i]);
+                        }
+                        crate::model::NodeMotion::Rotation(a) => {
+                            let _ = write!(s, " ROTATION AXIS {}", v3(a));
+                        }
+                    }
+                    let _ = write!(
+                        s,
+                        " FUNCTION {} AMPLITUDE {:?}",
+                        drive.function.0, drive.amplitude
+                    );
                 }
                 ElementKind::UJoint { axis1, axis2 } => {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));

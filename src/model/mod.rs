@@ -7,6 +7,7 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+mod drive;
 mod function;
 mod ids;
 mod mesh;
@@ -15,6 +16,7 @@ mod output;
 mod section;
 mod summary;
 
+pub use drive::{Drive, NodeMotion};
 pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
@@ -194,6 +196,13 @@ pub enum ElementKind {
     Rigid,
     /// Cam–follower contact (first node: cam, second: follower).
     Came(Box<CameData>),
+    /// A prescribed motion of one node (`PRESCRIBED`, [`drive`](self::Drive)).
+    Prescribed {
+        /// What is prescribed.
+        motion: NodeMotion,
+        /// Its value `a f(t)`.
+        drive: Drive,
+    },
 }
 
 impl ElementKind {
@@ -209,6 +218,7 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => "PRISMATIC",
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
+            ElementKind::Prescribed { .. } => "PRESCRIBED",
         }
     }
 
@@ -221,6 +231,7 @@ impl ElementKind {
             ElementKind::Clamp => 6,
             ElementKind::Prismatic { .. } => 5,
             ElementKind::Rigid => 6 * node_count.saturating_sub(1),
+            ElementKind::Prescribed { motion, .. } => motion.equations(),
             _ => 0,
         }
     }
@@ -404,4 +415,7 @@ pub struct Model {
     /// The interior nodes generated for beams of order > 1 (`ORDER p`), by element, along
     /// the axis (see [`order`](self::order)).
     pub order_nodes: IndexMap<ElementId, Vec<NodeId>>,
+    /// Driven joints (`HINGE … DRIVE f`, `PRISMATIC … DRIVE f`), by the joint's number:
+    /// one more constraint each (model/drive.rs).
+    pub drives: IndexMap<ElementId, Drive>,
 }

@@ -25,6 +25,9 @@ pub struct Effects {
     pub rigid_bodies: bool,
     /// At least one kinematic joint.
     pub joints: bool,
+    /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
+    /// prescribed in time, whose work enters the energy balance.
+    pub drivers: bool,
 }
 
 impl Effects {
@@ -41,6 +44,7 @@ impl Effects {
             (self.flexible_beams, "flexible beams"),
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
+            (self.drivers, "drivers"),
         ];
         for (on, name) in list {
             if on {
@@ -93,6 +97,7 @@ impl Model {
         let mut e = Effects {
             gravity: self.gravity.is_some(),
             applied_loads: !self.loads.is_empty(),
+            drivers: !self.drives.is_empty(),
             ..Effects::default()
         };
         for el in self.elements.values() {
@@ -123,6 +128,7 @@ impl Model {
                 | ElementKind::Spherical
                 | ElementKind::Clamp
                 | ElementKind::Prismatic { .. } => e.joints = true,
+                ElementKind::Prescribed { .. } => e.drivers = true,
             }
         }
         e
@@ -136,6 +142,7 @@ impl Model {
             *elements.entry(el.kind.keyword()).or_insert(0) += 1;
             constraints += el.kind.constraint_count(el.nodes.len());
         }
+        constraints += self.drives.len();
         let dofs = self
             .nodes
             .values()

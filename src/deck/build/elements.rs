@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 9] = [
+        const TYPES: [&str; 10] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -39,6 +39,7 @@ impl Builder<'_> {
             "PRISMATIC",
             "RIGID",
             "CAME",
+            "PRESCRIBED",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -178,6 +179,10 @@ impl Builder<'_> {
                 let n2 = c.uint("second node number")?;
                 c.expect_keyword(&["AXIS"], "AXIS <x> <y> <z>")?;
                 let (axis, _, _) = c.axis(&format!("{ty} AXIS"))?;
+                if let Some(d) = self.drive_option(&mut c)? {
+                    c.finish()?;
+                    self.drives.insert(ElementId(id), d);
+                }
                 c.finish()?;
                 let kind = if ty == "HINGE" {
                     ElementKind::Hinge { axis }
@@ -193,6 +198,8 @@ impl Builder<'_> {
                 let (a1, r1, s1) = c.axis("UJOINT AXIS1")?;
                 c.expect_keyword(&["AXIS2"], "AXIS2 <x> <y> <z>")?;
                 let (a2, r2, s2) = c.axis("UJOINT AXIS2")?;
+                c.ctx = format!("element {id} (UJOINT)");
+                Self::refuse_drive(&c)?;
                 c.finish()?;
                 let dot = r1.dot(&r2).abs() / (r1.norm() * r2.norm());
                 if dot.is_nan() || dot > 1e-6 {
@@ -212,6 +219,8 @@ impl Builder<'_> {
             "SPHERICAL" | "CLAMP" => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
+                c.ctx = format!("element {id} ({ty})");
+                Self::refuse_drive(&c)?;
                 c.finish()?;
                 let kind = if ty == "CLAMP" {
                     ElementKind::Clamp
@@ -221,11 +230,17 @@ impl Builder<'_> {
                 (vec![n1, n2], kind)
             }
             "RIGID" => {
+                c.ctx = format!("element {id} (RIGID)");
+                Self::refuse_drive(&c)?;
                 let mut ns = vec![c.uint("master node number")?, c.uint("second node number")?];
                 while c.peek().is_some() {
                     ns.push(c.uint("node number")?);
                 }
                 (ns, ElementKind::Rigid)
+            }
+            "PRESCRIBED" => {
+                let (n, kind) = self.prescribed(&mut c)?;
+                (vec![n], kind)
             }
             _ => {
                 let cam = c.uint("cam node number")?;

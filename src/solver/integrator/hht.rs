@@ -34,8 +34,15 @@ impl Integrator {
     }
 
     pub(super) fn accept(&mut self, h: f64, ctx: &EvalContext) {
+        // The drivers' power counts as external work (its multipliers at their own scale).
+        let ctx_old = EvalContext {
+            t: self.t,
+            constraint_scale: self.scale,
+            ..*ctx
+        };
         let p_old = if self.dynamic {
             self.sys.external_power(self.t, &self.nodes)
+                + self.sys.input_power(&ctx_old, &self.nodes, &self.lambda)
         } else {
             0.0
         };
@@ -59,7 +66,8 @@ impl Integrator {
         self.scale = ctx.constraint_scale;
         self.t += h;
         if self.dynamic {
-            let p_new = self.sys.external_power(self.t, &self.nodes);
+            let p_new = self.sys.external_power(self.t, &self.nodes)
+                + self.sys.input_power(ctx, &self.nodes, &self.lambda);
             self.external_work += 0.5 * (p_old + p_new) * h;
             let d_new: f64 = self
                 .sys

@@ -14,6 +14,21 @@ impl Integrator {
             .collect()
     }
 
+    /// The drivers' work over a trial step of size `h` (trapezoidal, as the loads'), J.
+    fn driver_work(&self, h: f64, ctx: &EvalContext) -> f64 {
+        if !self.sys.elements.iter().any(|e| e.rheonomic()) {
+            return 0.0;
+        }
+        let ctx_old = EvalContext {
+            t: self.t,
+            constraint_scale: self.scale,
+            ..*ctx
+        };
+        let p_old = self.sys.input_power(&ctx_old, &self.nodes, &self.lambda);
+        let p_new = self.sys.input_power(ctx, &self.trial, &self.trial_lambda);
+        0.5 * (p_old + p_new) * h
+    }
+
     pub(super) fn failure(
         &self,
         h: f64,
@@ -182,13 +197,14 @@ impl Integrator {
             if converged {
                 // A converged state must not hold energy the step cannot pay for.
                 if self.dynamic
-                    && let Some(j) = crate::solver::energy_guard::check(
+                    && let Some(j) = crate::solver::energy_guard::check_driven(
                         &self.sys,
                         &self.nodes,
                         &self.trial,
                         self.t,
                         h,
                         self.residual_floor * self.sys.ref_length,
+                        self.driver_work(h, &ctx),
                     )
                 {
                     return Err(self.failure(
