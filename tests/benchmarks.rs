@@ -82,7 +82,8 @@ fn max_diff(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
 /// The reference points of Simo & Vu-Quoc (1988), digitized off their figures
 /// (AeroBeams.jl test/referenceData/elbowFrame; /work/shared/design/benchmarks.md):
 /// (node, search window, sign, time s, u₃ m). Node 3 the tip, node 2 the elbow.
-const DIGITIZED: [(u32, (f64, f64), f64, f64, f64); 4] = [
+type Digitized = (u32, (f64, f64), f64, f64, f64);
+const DIGITIZED: [Digitized; 4] = [
     (3, (5.0, 10.0), 1.0, 7.67, 8.29),
     (3, (13.0, 18.0), -1.0, 15.99, -9.67),
     (2, (2.0, 5.0), 1.0, 3.05, 5.50),
@@ -112,7 +113,8 @@ fn right_angle_cantilever_matches_the_figure_and_converges() {
         let (hist, cpu) = run(&m);
         (u3(&m, &hist, 3), u3(&m, &hist, 2), cpu)
     };
-    let ladder = |runs: &[(Vec<(f64, f64)>, Vec<(f64, f64)>, f64)], what: &str| {
+    type Run = (Vec<(f64, f64)>, Vec<(f64, f64)>, f64);
+    let ladder = |runs: &[Run], what: &str| {
         let d = |i: usize| {
             max_diff(&runs[i].0, &runs[i + 1].0).max(max_diff(&runs[i].1, &runs[i + 1].1))
         };

@@ -134,9 +134,9 @@ pub fn mid_span(p: &SliderCrank, modes: usize, end: f64, dt: f64, every: usize) 
                 let force = -p.rho_a
                     * (a2 * l * (1.0 - (-sign)) / (nn * PI) + ddphi * sign * l * l / (nn * PI));
                 let mut stiff = (p.ei * kn.powi(4) - p.rho_a * dphi * dphi) * (l / 2.0) * q[n];
-                for m in 0..modes {
+                for (m, qm) in q.iter().enumerate() {
                     let i = n * modes + m;
-                    stiff += (c0 * mo[0][i] + c1 * mo[1][i] + c2 * mo[2][i]) * q[m];
+                    stiff += (c0 * mo[0][i] + c1 * mo[1][i] + c2 * mo[2][i]) * qm;
                 }
                 (force - stiff) / mass
             })
