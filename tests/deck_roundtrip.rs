@@ -5,10 +5,13 @@ use mecano::deck::{load_deck, parse_deck, strip_spans, write_deck};
 use mecano::model::{ElementKind, Model};
 use std::path::PathBuf;
 
+/// The decks of `decks/` and of `decks/benchmarks/`.
 fn decks() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("decks");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("decks/ exists")
+    let mut v: Vec<PathBuf> = [dir.clone(), dir.join("benchmarks")]
+        .iter()
+        .filter_map(|d| std::fs::read_dir(d).ok())
+        .flatten()
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "dat"))
         .collect();

@@ -440,15 +440,10 @@ impl RacketBeam {
                 ElementKind::Beam {
                     material, section, ..
                 } => {
-                    let (m, s) = (&model.materials[material], &model.sections[section]);
+                    let (p, _) = model.beam_properties(*material, *section);
                     let n = [node(model, el.nodes[0].0), node(model, el.nodes[1].0)];
                     let le = (model.nodes[n[1]].position - model.nodes[n[0]].position).norm();
-                    let rho = m.density;
-                    beams.push((
-                        n,
-                        rho * s.area * le,
-                        Vector3::new(rho * (s.i2 + s.i3), rho * s.i2, rho * s.i3) * (0.5 * le),
-                    ));
+                    beams.push((n, p.mass * le, p.inertia * (0.5 * le)));
                 }
                 ElementKind::Mass { inertia, .. } => {
                     masses.push((node(model, el.nodes[0].0), *inertia));

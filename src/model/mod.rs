@@ -13,6 +13,7 @@ mod ids;
 mod mesh;
 pub mod order;
 mod output;
+mod section;
 mod summary;
 
 pub use drive::{Drive, NodeMotion};
@@ -20,6 +21,7 @@ pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};
+pub use section::{BeamProperties, Geometry, Section, SectionData};
 pub use summary::{Effects, Generated, Summary};
 
 use indexmap::IndexMap;
@@ -71,27 +73,6 @@ pub struct Material {
     /// Stiffness-proportional (Rayleigh) damping coefficient, s (≥ 0; 0 = none).
     pub damping: f64,
     /// Where the material was defined.
-    pub span: Span,
-}
-
-/// A beam cross-section.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Section {
-    /// The user's number.
-    pub id: SectionId,
-    /// Area A, m².
-    pub area: f64,
-    /// Second moment about local axis 2, I2, m⁴.
-    pub i2: f64,
-    /// Second moment about local axis 3, I3, m⁴.
-    pub i3: f64,
-    /// Torsion constant J, m⁴.
-    pub torsion: f64,
-    /// Shear correction factor k (default 5/6).
-    pub shear_factor: f64,
-    /// A rigid section: the bar keeps its shape (its mass still comes from ρA).
-    pub rigid: bool,
-    /// Where the section was defined.
     pub span: Span,
 }
 
@@ -169,8 +150,9 @@ pub enum ElementKind {
     /// Geometrically exact beam of order `order` (`order + 1` nodes along the axis: the
     /// two ends the user named and, for `order > 1`, generated interior nodes).
     Beam {
-        /// Material.
-        material: MaterialId,
+        /// Material: `Some` exactly when the section is given by its geometry
+        /// ([`Section::needs_material`]); a section of properties per unit length has none.
+        material: Option<MaterialId>,
         /// Section.
         section: SectionId,
         /// Direction of the section's local axis 2 in the reference configuration

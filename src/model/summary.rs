@@ -115,10 +115,11 @@ impl Model {
                         e.rigid_bodies = true;
                     } else {
                         e.flexible_beams = true;
+                        let mat = material.and_then(|m| self.materials.get(&m));
                         e.material_damping |= self
-                            .materials
-                            .get(material)
-                            .is_some_and(|m| m.damping > 0.0);
+                            .sections
+                            .get(section)
+                            .is_some_and(|s| s.damping(mat) > 0.0);
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,

@@ -8,6 +8,7 @@ mod drives;
 mod elements;
 mod nodes;
 mod properties;
+mod section;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
