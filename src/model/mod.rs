@@ -7,6 +7,7 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+mod clearance;
 mod function;
 mod ids;
 mod mesh;
@@ -14,6 +15,7 @@ pub mod order;
 mod output;
 mod summary;
 
+pub use clearance::{ClearanceData, ContactLaw};
 pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
@@ -212,6 +214,8 @@ pub enum ElementKind {
     Rigid,
     /// Cam–follower contact (first node: cam, second: follower).
     Came(Box<CameData>),
+    /// Revolute joint with radial clearance (first node: bearing, second: journal).
+    Clearance(Box<ClearanceData>),
 }
 
 impl ElementKind {
@@ -227,6 +231,7 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => "PRISMATIC",
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
+            ElementKind::Clearance(_) => "CLEARANCE",
         }
     }
 

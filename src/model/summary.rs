@@ -25,6 +25,8 @@ pub struct Effects {
     pub rigid_bodies: bool,
     /// At least one kinematic joint.
     pub joints: bool,
+    /// At least one revolute joint with clearance (CLEARANCE).
+    pub clearances: bool,
 }
 
 impl Effects {
@@ -41,6 +43,7 @@ impl Effects {
             (self.flexible_beams, "flexible beams"),
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
+            (self.clearances, "clearance joints"),
         ];
         for (on, name) in list {
             if on {
@@ -117,6 +120,10 @@ impl Model {
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
+                ElementKind::Clearance(c) => {
+                    e.clearances = true;
+                    e.friction |= c.friction > 0.0;
+                }
                 ElementKind::Hinge { .. }
                 | ElementKind::UJoint { .. }
                 | ElementKind::Spherical

@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 9] = [
+        const TYPES: [&str; 10] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -39,6 +39,7 @@ impl Builder<'_> {
             "PRISMATIC",
             "RIGID",
             "CAME",
+            "CLEARANCE",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -220,6 +221,15 @@ impl Builder<'_> {
                     ns.push(c.uint("node number")?);
                 }
                 (ns, ElementKind::Rigid)
+            }
+            "CLEARANCE" => {
+                let bearing = c.uint("bearing node number")?;
+                let journal = c.uint("journal node number")?;
+                let data = Self::clearance(&mut c)?;
+                (
+                    vec![bearing, journal],
+                    ElementKind::Clearance(Box::new(data)),
+                )
             }
             _ => {
                 let cam = c.uint("cam node number")?;
