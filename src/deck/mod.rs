@@ -343,6 +343,33 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ELEMENTS",
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
+    kw(
+        "CLEARANCE",
+        "ELEMENTS",
+        "revolute joint with radial clearance (element type; and its clearance, m)",
+    ),
+    kw("RADIUS", "ELEMENTS", "CLEARANCE: bearing radius, m"),
+    kw(
+        "LAW",
+        "ELEMENTS",
+        "CLEARANCE: the normal force law (KV or LN)",
+    ),
+    kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
+    kw(
+        "LN",
+        "ELEMENTS",
+        "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
+    ),
+    kw(
+        "EXPONENT",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
+    ),
+    kw(
+        "VMIN",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
+    ),
     // functions
     kw(
         "TABLE",

@@ -8,6 +8,7 @@
 
 pub mod arc;
 mod drive;
+mod clearance;
 mod function;
 mod ids;
 mod mesh;
@@ -17,6 +18,7 @@ mod section;
 mod summary;
 
 pub use drive::{Drive, NodeMotion};
+pub use clearance::{ClearanceData, ContactLaw};
 pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
@@ -203,6 +205,8 @@ pub enum ElementKind {
         /// Its value `a f(t)`.
         drive: Drive,
     },
+    /// Revolute joint with radial clearance (first node: bearing, second: journal).
+    Clearance(Box<ClearanceData>),
 }
 
 impl ElementKind {
@@ -219,6 +223,7 @@ impl ElementKind {
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
             ElementKind::Prescribed { .. } => "PRESCRIBED",
+            ElementKind::Clearance(_) => "CLEARANCE",
         }
     }
 
