@@ -6,14 +6,14 @@
 mod common;
 
 use common::deck;
-use mecano::model::{ElementId, ElementKind, Model, NodeId};
+use mecano::model::{ElementId, ElementKind, Model, NodeId, Scheme};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::f64::consts::PI;
 
 fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
     assert!(
-        model.set_fixed_step(h, t_end, alpha),
+        model.set_fixed_step(h, t_end, alpha.map(|alpha| Scheme::Hht { alpha })),
         "dynamic deck expected"
     );
 }

@@ -392,7 +392,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "time function scaling a FORCE or MOMENT",
     ),
     // analysis
-    kw("DYNAMIC", "ANALYSIS", "implicit dynamics with HHT"),
+    kw(
+        "DYNAMIC",
+        "ANALYSIS",
+        "implicit dynamics (HHT-alpha, or generalized-alpha with GENALPHA)",
+    ),
     kw("STATIC", "ANALYSIS", "static equilibrium with load steps"),
     kw(
         "MODES",
@@ -403,6 +407,16 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ALPHA",
         "ANALYSIS",
         "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",
+    ),
+    kw(
+        "GENALPHA",
+        "ANALYSIS",
+        "generalized-alpha time integration instead of HHT",
+    ),
+    kw(
+        "RHOINF",
+        "ANALYSIS",
+        "generalized-alpha: spectral radius at infinity (0 <= rho <= 1, default 0.8)",
     ),
     kw("STEP", "ANALYSIS", "time step, s (> 0)"),
     kw(

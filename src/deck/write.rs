@@ -6,7 +6,7 @@
 
 use crate::model::{
     Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
-    Section, SectionData, Selection,
+    Scheme, Section, SectionData, Selection,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
@@ -307,7 +307,7 @@ pub fn write_deck(model: &Model) -> String {
         }
         (
             Analysis::Dynamic {
-                alpha,
+                scheme,
                 step,
                 end,
                 min_step,
@@ -317,9 +317,15 @@ pub fn write_deck(model: &Model) -> String {
             },
             None,
         ) => {
+            let _ = match scheme {
+                Scheme::Hht { alpha } => write!(s, "ANALYSIS DYNAMIC ALPHA {alpha:?}"),
+                Scheme::GeneralizedAlpha { rho_inf } => {
+                    write!(s, "ANALYSIS DYNAMIC GENALPHA RHOINF {rho_inf:?}")
+                }
+            };
             let _ = write!(
                 s,
-                "ANALYSIS DYNAMIC ALPHA {alpha:?} STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
+                " STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
             );
             if let Some(a) = adaptive {
                 let _ = write!(

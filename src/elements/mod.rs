@@ -18,8 +18,8 @@
 pub mod beam;
 pub mod beam_p;
 pub mod came;
-pub mod drive;
 pub mod clearance;
+pub mod drive;
 pub mod joints;
 pub mod mass;
 pub mod prescribed;
