@@ -28,6 +28,8 @@ pub struct Effects {
     /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
     /// prescribed in time, whose work enters the energy balance.
     pub drivers: bool,
+    /// At least one revolute joint with clearance (CLEARANCE).
+    pub clearances: bool,
 }
 
 impl Effects {
@@ -45,6 +47,7 @@ impl Effects {
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
             (self.drivers, "drivers"),
+            (self.clearances, "clearance joints"),
         ];
         for (on, name) in list {
             if on {
@@ -115,13 +118,18 @@ impl Model {
                         e.rigid_bodies = true;
                     } else {
                         e.flexible_beams = true;
+                        let mat = material.and_then(|m| self.materials.get(&m));
                         e.material_damping |= self
-                            .materials
-                            .get(material)
-                            .is_some_and(|m| m.damping > 0.0);
+                            .sections
+                            .get(section)
+                            .is_some_and(|s| s.damping(mat) > 0.0);
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
+                ElementKind::Clearance(c) => {
+                    e.clearances = true;
+                    e.friction |= c.friction > 0.0;
+                }
                 ElementKind::Hinge { .. }
                 | ElementKind::UJoint { .. }
                 | ElementKind::Spherical

@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 10] = [
+        const TYPES: [&str; 11] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -40,6 +40,7 @@ impl Builder<'_> {
             "RIGID",
             "CAME",
             "PRESCRIBED",
+            "CLEARANCE",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -108,31 +109,37 @@ impl Builder<'_> {
                 // Report the first mistake in reading order: nodes come before MAT.
                 self.node_ref(n1.0, n1.1)?;
                 self.node_ref(n2.0, n2.1)?;
-                let (mat, ms) = mat.ok_or_else(|| miss("MAT <material number>"))?;
                 let (sec, ss) = sec.ok_or_else(|| miss("SEC <section number>"))?;
-                if !self.materials.contains_key(&MaterialId(mat)) {
-                    return Err(DeckError::new(
-                        K::Undefined {
-                            what: "material",
-                            id: mat,
-                        },
-                        ms,
-                    ));
-                }
-                if !self.sections.contains_key(&SectionId(sec)) {
-                    return Err(DeckError::new(
-                        K::Undefined {
-                            what: "section",
-                            id: sec,
-                        },
-                        ss,
-                    ));
-                }
+                let Some(section) = self.sections.get(&SectionId(sec)) else {
+                    let what = "section";
+                    return Err(DeckError::new(K::Undefined { what, id: sec }, ss));
+                };
+                // A section of properties per unit length takes no material.
+                let material = match (section.needs_material(), mat) {
+                    (true, None) => return Err(miss("MAT <material number>")),
+                    (true, Some((m, ms))) => {
+                        if !self.materials.contains_key(&MaterialId(m)) {
+                            let what = "material";
+                            return Err(DeckError::new(K::Undefined { what, id: m }, ms));
+                        }
+                        Some(MaterialId(m))
+                    }
+                    (false, None) => None,
+                    (false, Some((m, ms))) => {
+                        let (element, material, section) = (id, m, sec);
+                        let kind = K::MaterialNotUsed {
+                            element,
+                            material,
+                            section,
+                        };
+                        return Err(DeckError::new(kind, ms));
+                    }
+                };
                 return self.beams(
                     id,
                     last.unwrap_or(id),
                     (n1, n2),
-                    (MaterialId(mat), SectionId(sec)),
+                    (material, SectionId(sec)),
                     axis2.map(|(u, _, s)| (u, s)),
                     (divide.unwrap_or(1), order, arc),
                     span,
@@ -236,6 +243,15 @@ impl Builder<'_> {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)
             }
+            "CLEARANCE" => {
+                let bearing = c.uint("bearing node number")?;
+                let journal = c.uint("journal node number")?;
+                let data = Self::clearance(&mut c)?;
+                (
+                    vec![bearing, journal],
+                    ElementKind::Clearance(Box::new(data)),
+                )
+            }
             _ => {
                 let cam = c.uint("cam node number")?;
                 let fol = c.uint("follower node number")?;
@@ -283,7 +299,7 @@ impl Builder<'_> {
         first: u32,
         last: u32,
         ((n1, s1), (n2, s2)): ((u32, Span), (u32, Span)),
-        (material, section): (MaterialId, SectionId),
+        (material, section): (Option<MaterialId>, SectionId),
         axis2: Option<(Vector3<f64>, Span)>,
         (divide, order, arc): (u32, u32, Option<(Vector3<f64>, Span)>),
         span: Span,

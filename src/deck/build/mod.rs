@@ -3,11 +3,13 @@
 
 mod analysis;
 mod checks;
+mod clearance;
 mod cursor;
 mod drives;
 mod elements;
 mod nodes;
 mod properties;
+mod section;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
