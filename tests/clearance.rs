@@ -7,6 +7,7 @@
 mod common;
 
 use common::deck;
+use common::impact::{impact_ode, lankarani_nikravesh};
 use mecano::model::{ContactLaw, ElementKind, Model, NodeId};
 use mecano::solver::{self, Observer, Snapshot};
 use nalgebra::Vector3;
@@ -81,33 +82,6 @@ fn impact(rec: &Rec, c: f64) -> (f64, f64) {
     (rec.v[i_in - 1].x, rec.v[i_out].x)
 }
 
-/// The 1-D impact `m δ̈ = −F(δ, δ̇)` from `δ = 0`, `δ̇ = v0`, by RK4 with `n` steps over
-/// the estimated duration, until the force stops (clipped) and the penetration closes:
-/// the rebound speed over `v0`.
-fn impact_ode(m: f64, v0: f64, force: impl Fn(f64, f64) -> f64, t_est: f64, n: usize) -> f64 {
-    let h = t_est / n as f64;
-    let acc = |d: f64, dd: f64| -force(d, dd).max(0.0) / m;
-    let (mut d, mut dd) = (0.0f64, v0);
-    for _ in 0..20 * n {
-        let (k1d, k1v) = (dd, acc(d, dd));
-        let (k2d, k2v) = (
-            dd + 0.5 * h * k1v,
-            acc(d + 0.5 * h * k1d, dd + 0.5 * h * k1v),
-        );
-        let (k3d, k3v) = (
-            dd + 0.5 * h * k2v,
-            acc(d + 0.5 * h * k2d, dd + 0.5 * h * k2v),
-        );
-        let (k4d, k4v) = (dd + h * k3v, acc(d + h * k3d, dd + h * k3v));
-        d += h / 6.0 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d);
-        dd += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-        if d <= 0.0 && dd < 0.0 {
-            return -dd / v0;
-        }
-    }
-    panic!("the impact ODE did not release");
-}
-
 /// Lankarani–Nikravesh, `decks/clearance_impact.dat` (1 kg at 1 m/s, K = 1e10, n = 1.5,
 /// e = 0.8, α = 0, 100 steps per impact): the journal's rebound speed against the impact
 /// ODE `m δ̈ = −K δⁿ (1 + 3(1 − e²)/4 · δ̇/v₀)` integrated here by RK4 (20,000 steps over the
@@ -124,21 +98,9 @@ fn lankarani_nikravesh_restitution_matches_the_impact_ode() {
     let (c, m, k, n, e) = (5e-4, 1.0, 1e10, 1.5, 0.8);
     let (v_in, v_out) = impact(&rec, c);
     let e_sim = -v_out / v_in;
-    let d = 0.75 * (1.0 - e * e);
     let dmax = (5.0 * m * v_in * v_in / (4.0 * k)).powf(0.4);
-    let e_ref = impact_ode(
-        m,
-        v_in,
-        |x, xd| {
-            if x > 0.0 {
-                k * x.powf(n) * (1.0 + d * xd / v_in)
-            } else {
-                0.0
-            }
-        },
-        3.0 * dmax / v_in,
-        20_000,
-    );
+    let law = lankarani_nikravesh(k, n, e, v_in);
+    let (e_ref, _) = impact_ode(m, v_in, law, 3.0 * dmax / v_in, 20_000);
     let n_imp = 100.0;
     let tol = e_ref.ln().abs() * (std::f64::consts::PI / n_imp).powi(2) / 4.0 + 1e-4;
     println!(
