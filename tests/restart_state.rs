@@ -196,3 +196,14 @@ fn a_stop_at_a_pause_ends_at_that_step() {
     assert_eq!(rep.interrupted, Some(solver::Interruption::AtStep));
     assert_eq!(rep.stats.steps, 30);
 }
+
+#[test]
+fn clearance_joint_restarts_bit_for_bit() {
+    // A journal bouncing and rolling in its bearing (touches, restarts of the
+    // accelerations, releases, the approach speed of each impact, friction).
+    check_restarts(
+        "clearance_orbit",
+        &deck("clearance_orbit.dat"),
+        &[0.2, 0.5, 0.8],
+    );
+}
