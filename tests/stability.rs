@@ -734,8 +734,28 @@ fn clearance_joint_hard_impact_over_the_step_range() {
             rise(&rec)
         );
         assert!(rise(&rec) <= 1e-6 * e0, "energy created");
+        assert_eq!(s["unresolved_steps"], 0, "every impact resolved");
         pens.push(pen);
     }
+    // The same impact with steps that may not be cut (MINSTEP = STEP = 1e-4 s, 3 steps per
+    // crossing of the clearance and none per impact): the run goes through, but it is not
+    // silently wrong: the joint counts the steps it had to accept unresolved.
+    let mut model = deck("stab_clearance_impact.dat");
+    set_steps(&mut model, 1e-4, 2e-3, None);
+    if let mecano::model::Analysis::Dynamic { min_step, .. } = &mut model.analysis {
+        *min_step = 1e-4;
+    }
+    let mut integ = solver::prepare(&model).expect("prepare");
+    let mut rec = Rec::default();
+    let rep = solver::run_prepared(&model, &mut integ, &mut rec).expect("run starts");
+    let s = integ.sys.elements[0].summary().expect("summary");
+    println!(
+        "clearance impact, h = MINSTEP = 1e-4: {:?}, {} unresolved steps, rise {:.2e} J",
+        rep.failure.as_ref().map(|f| f.to_string()),
+        s["unresolved_steps"],
+        rise(&rec)
+    );
+    assert!(s["unresolved_steps"].as_u64().unwrap() > 0);
     let (m, v0, k) = (1.0, 5.0, 6.61e10f64);
     let hertz = (5.0 * m * v0 * v0 / (4.0 * k)).powf(0.4);
     let law = common::impact::lankarani_nikravesh(k, 1.5, 0.9, v0);
