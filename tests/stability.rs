@@ -6,14 +6,14 @@
 mod common;
 
 use common::deck;
-use mecano::model::{ElementId, ElementKind, Model, NodeId};
+use mecano::model::{ElementId, ElementKind, Model, NodeId, Scheme};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::f64::consts::PI;
 
 fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
     assert!(
-        model.set_fixed_step(h, t_end, alpha),
+        model.set_fixed_step(h, t_end, alpha.map(|alpha| Scheme::Hht { alpha })),
         "dynamic deck expected"
     );
 }
@@ -440,15 +440,10 @@ impl RacketBeam {
                 ElementKind::Beam {
                     material, section, ..
                 } => {
-                    let (m, s) = (&model.materials[material], &model.sections[section]);
+                    let (p, _) = model.beam_properties(*material, *section);
                     let n = [node(model, el.nodes[0].0), node(model, el.nodes[1].0)];
                     let le = (model.nodes[n[1]].position - model.nodes[n[0]].position).norm();
-                    let rho = m.density;
-                    beams.push((
-                        n,
-                        rho * s.area * le,
-                        Vector3::new(rho * (s.i2 + s.i3), rho * s.i2, rho * s.i3) * (0.5 * le),
-                    ));
+                    beams.push((n, p.mass * le, p.inertia * (0.5 * le)));
                 }
                 ElementKind::Mass { inertia, .. } => {
                     masses.push((node(model, el.nodes[0].0), *inertia));

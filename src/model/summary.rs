@@ -25,6 +25,9 @@ pub struct Effects {
     pub rigid_bodies: bool,
     /// At least one kinematic joint.
     pub joints: bool,
+    /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
+    /// prescribed in time, whose work enters the energy balance.
+    pub drivers: bool,
     /// At least one revolute joint with clearance (CLEARANCE).
     pub clearances: bool,
 }
@@ -43,6 +46,7 @@ impl Effects {
             (self.flexible_beams, "flexible beams"),
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
+            (self.drivers, "drivers"),
             (self.clearances, "clearance joints"),
         ];
         for (on, name) in list {
@@ -96,6 +100,7 @@ impl Model {
         let mut e = Effects {
             gravity: self.gravity.is_some(),
             applied_loads: !self.loads.is_empty(),
+            drivers: !self.drives.is_empty(),
             ..Effects::default()
         };
         for el in self.elements.values() {
@@ -113,10 +118,11 @@ impl Model {
                         e.rigid_bodies = true;
                     } else {
                         e.flexible_beams = true;
+                        let mat = material.and_then(|m| self.materials.get(&m));
                         e.material_damping |= self
-                            .materials
-                            .get(material)
-                            .is_some_and(|m| m.damping > 0.0);
+                            .sections
+                            .get(section)
+                            .is_some_and(|s| s.damping(mat) > 0.0);
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
@@ -129,6 +135,7 @@ impl Model {
                 | ElementKind::Spherical
                 | ElementKind::Clamp
                 | ElementKind::Prismatic { .. } => e.joints = true,
+                ElementKind::Prescribed { .. } => e.drivers = true,
             }
         }
         e
@@ -142,6 +149,7 @@ impl Model {
             *elements.entry(el.kind.keyword()).or_insert(0) += 1;
             constraints += el.kind.constraint_count(el.nodes.len());
         }
+        constraints += self.drives.len();
         let dofs = self
             .nodes
             .values()

@@ -11,10 +11,10 @@ pub mod redundancy;
 pub mod state;
 pub mod system;
 
-pub use integrator::{HhtParams, Integrator, StepInfo};
+pub use integrator::{AlphaParams, Integrator, StepInfo};
 pub use system::{BuildError, System};
 
-use crate::model::{Analysis, Model};
+use crate::model::{Analysis, Model, Scheme};
 use std::time::Instant;
 
 /// Counters of a run (written to `summary.json`).
@@ -214,10 +214,12 @@ pub enum RunError {
 pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     let sys = System::new(model)?;
     let mut integ = match &model.analysis {
-        Analysis::Dynamic { alpha, newton, .. } => {
-            Integrator::new(sys, newton.clone(), *alpha, true)
+        Analysis::Dynamic { scheme, newton, .. } => {
+            Integrator::new(sys, newton.clone(), *scheme, true)
         }
-        Analysis::Static { newton, .. } => Integrator::new(sys, newton.clone(), 0.0, false),
+        Analysis::Static { newton, .. } => {
+            Integrator::new(sys, newton.clone(), Scheme::Hht { alpha: 0.0 }, false)
+        }
     };
     if integ.dynamic {
         for iv in &model.initial {
