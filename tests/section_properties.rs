@@ -112,8 +112,8 @@ fn same_history(name: &str, m: Model) {
 
 /// Cuts a dynamic analysis to `steps` of its step.
 fn cut(mut m: Model, steps: f64) -> Model {
-    if let mecano::model::Analysis::Dynamic { step, alpha, .. } = m.analysis {
-        assert!(m.set_fixed_step(step, steps * step, Some(alpha)));
+    if let mecano::model::Analysis::Dynamic { step, .. } = m.analysis {
+        assert!(m.set_fixed_step(step, steps * step, None));
     }
     m
 }

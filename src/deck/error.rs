@@ -71,7 +71,7 @@ pub enum DeckErrorKind {
     },
     /// An unknown element type.
     #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME"
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE"
     )]
     UnknownElementType {
         /// The word.

@@ -343,6 +343,33 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ELEMENTS",
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
+    kw(
+        "CLEARANCE",
+        "ELEMENTS",
+        "revolute joint with radial clearance (element type; and its clearance, m)",
+    ),
+    kw("RADIUS", "ELEMENTS", "CLEARANCE: bearing radius, m"),
+    kw(
+        "LAW",
+        "ELEMENTS",
+        "CLEARANCE: the normal force law (KV or LN)",
+    ),
+    kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
+    kw(
+        "LN",
+        "ELEMENTS",
+        "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
+    ),
+    kw(
+        "EXPONENT",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
+    ),
+    kw(
+        "VMIN",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
+    ),
     // functions
     kw(
         "TABLE",
@@ -365,7 +392,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "time function scaling a FORCE or MOMENT",
     ),
     // analysis
-    kw("DYNAMIC", "ANALYSIS", "implicit dynamics with HHT"),
+    kw(
+        "DYNAMIC",
+        "ANALYSIS",
+        "implicit dynamics (HHT-alpha, or generalized-alpha with GENALPHA)",
+    ),
     kw("STATIC", "ANALYSIS", "static equilibrium with load steps"),
     kw(
         "MODES",
@@ -376,6 +407,16 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ALPHA",
         "ANALYSIS",
         "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",
+    ),
+    kw(
+        "GENALPHA",
+        "ANALYSIS",
+        "generalized-alpha time integration instead of HHT",
+    ),
+    kw(
+        "RHOINF",
+        "ANALYSIS",
+        "generalized-alpha: spectral radius at infinity (0 <= rho <= 1, default 0.8)",
     ),
     kw("STEP", "ANALYSIS", "time step, s (> 0)"),
     kw(
@@ -599,4 +640,10 @@ pub fn strip_spans(model: &mut Model) {
     model.elements.values_mut().for_each(|x| x.span = zero);
     model.loads.iter_mut().for_each(|x| x.span = zero);
     model.initial.iter_mut().for_each(|x| x.span = zero);
+    model.drives.values_mut().for_each(|x| x.span = zero);
+    for e in model.elements.values_mut() {
+        if let crate::model::ElementKind::Prescribed { drive, .. } = &mut e.kind {
+            drive.span = zero;
+        }
+    }
 }

@@ -5,8 +5,8 @@
 //! written explicitly.
 
 use crate::model::{
-    Analysis, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile, Section,
-    SectionData, Selection,
+    Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
+    Scheme, Section, SectionData, Selection,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
@@ -230,6 +230,27 @@ pub fn write_deck(model: &Model) -> String {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
                 }
                 ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
+                ElementKind::Clearance(c) => {
+                    let law = match c.law {
+                        ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
+                        ContactLaw::LankaraniNikravesh {
+                            k,
+                            exponent,
+                            restitution,
+                        } => format!("LN {k:?} {restitution:?} EXPONENT {exponent:?}"),
+                    };
+                    let _ = write!(
+                        s,
+                        " AXIS {} RADIUS {:?} CLEARANCE {:?} LAW {law} MU {:?} VREG {:?} VMIN {:?} IMPACT_STEPS {}",
+                        v3(&c.axis),
+                        c.radius,
+                        c.clearance,
+                        c.friction,
+                        c.friction_speed,
+                        c.min_approach,
+                        c.impact_steps
+                    );
+                }
                 ElementKind::Came(c) => {
                     let _ = write!(
                         s,
@@ -286,7 +307,7 @@ pub fn write_deck(model: &Model) -> String {
         }
         (
             Analysis::Dynamic {
-                alpha,
+                scheme,
                 step,
                 end,
                 min_step,
@@ -296,9 +317,15 @@ pub fn write_deck(model: &Model) -> String {
             },
             None,
         ) => {
+            let _ = match scheme {
+                Scheme::Hht { alpha } => write!(s, "ANALYSIS DYNAMIC ALPHA {alpha:?}"),
+                Scheme::GeneralizedAlpha { rho_inf } => {
+                    write!(s, "ANALYSIS DYNAMIC GENALPHA RHOINF {rho_inf:?}")
+                }
+            };
             let _ = write!(
                 s,
-                "ANALYSIS DYNAMIC ALPHA {alpha:?} STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
+                " STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
             );
             if let Some(a) = adaptive {
                 let _ = write!(

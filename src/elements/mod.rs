@@ -18,6 +18,7 @@
 pub mod beam;
 pub mod beam_p;
 pub mod came;
+pub mod clearance;
 pub mod drive;
 pub mod joints;
 pub mod mass;
@@ -109,6 +110,16 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     drive::TimeLaw::from_model(model, drive),
                 )));
             }
+            ElementKind::Clearance(data) => {
+                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
+                let c = clearance::Clearance::new(el.id, nodes, data).map_err(|message| {
+                    BuildError::Invalid {
+                        element: el.id,
+                        message,
+                    }
+                })?;
+                out.push(Box::new(c));
+            }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
@@ -131,6 +142,8 @@ pub enum ElementState {
     Came(came::CameState),
     /// A joint ([`joints::Joint`]).
     Joint(joints::JointState),
+    /// A revolute joint with clearance ([`clearance::Clearance`]).
+    Clearance(clearance::ClearanceState),
 }
 
 /// A saved [`ElementState`] that does not belong to the element it is given to.

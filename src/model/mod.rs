@@ -7,20 +7,24 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+mod clearance;
 mod drive;
 mod function;
 mod ids;
 mod mesh;
 pub mod order;
 mod output;
+mod scheme;
 mod section;
 mod summary;
 
+pub use clearance::{ClearanceData, ContactLaw};
 pub use drive::{Drive, NodeMotion};
 pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};
+pub use scheme::{Scheme, SchemeNameError};
 pub use section::{BeamProperties, Geometry, Section, SectionData};
 pub use summary::{Effects, Generated, Summary};
 
@@ -203,6 +207,8 @@ pub enum ElementKind {
         /// Its value `a f(t)`.
         drive: Drive,
     },
+    /// Revolute joint with radial clearance (first node: bearing, second: journal).
+    Clearance(Box<ClearanceData>),
 }
 
 impl ElementKind {
@@ -219,6 +225,7 @@ impl ElementKind {
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
             ElementKind::Prescribed { .. } => "PRESCRIBED",
+            ElementKind::Clearance(_) => "CLEARANCE",
         }
     }
 
@@ -318,10 +325,10 @@ pub struct Adaptive {
 /// The analysis to run.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Analysis {
-    /// Implicit dynamics with HHT.
+    /// Implicit dynamics.
     Dynamic {
-        /// HHT α ∈ [−1/3, 0].
-        alpha: f64,
+        /// The time integration scheme (HHT-α, generalized-α, …).
+        scheme: Scheme,
         /// Time step h (initial step when adaptive), s.
         step: f64,
         /// End time, s.
@@ -347,15 +354,15 @@ pub enum Analysis {
 
 impl Model {
     /// Switches a dynamic analysis to fixed steps `h` (minimum step `h/1024`) up to `end`,
-    /// with HHT `alpha` if given; returns `false` (and changes nothing) for a static one.
-    /// For studies and tests that rerun a deck at other steps.
-    pub fn set_fixed_step(&mut self, h: f64, end: f64, alpha: Option<f64>) -> bool {
+    /// with the time integration `scheme` if given; returns `false` (and changes nothing)
+    /// for a static one. For studies and tests that rerun a deck at other steps.
+    pub fn set_fixed_step(&mut self, h: f64, end: f64, scheme: Option<Scheme>) -> bool {
         let Analysis::Dynamic {
             step,
             end: e,
             min_step,
             max_step,
-            alpha: a,
+            scheme: a,
             adaptive,
             ..
         } = &mut self.analysis
@@ -367,7 +374,7 @@ impl Model {
         *min_step = h / 1024.0;
         *max_step = h;
         *adaptive = None;
-        if let Some(v) = alpha {
+        if let Some(v) = scheme {
             *a = v;
         }
         true

@@ -28,6 +28,8 @@ pub struct Effects {
     /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
     /// prescribed in time, whose work enters the energy balance.
     pub drivers: bool,
+    /// At least one revolute joint with clearance (CLEARANCE).
+    pub clearances: bool,
 }
 
 impl Effects {
@@ -45,6 +47,7 @@ impl Effects {
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
             (self.drivers, "drivers"),
+            (self.clearances, "clearance joints"),
         ];
         for (on, name) in list {
             if on {
@@ -123,6 +126,10 @@ impl Model {
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
+                ElementKind::Clearance(c) => {
+                    e.clearances = true;
+                    e.friction |= c.friction > 0.0;
+                }
                 ElementKind::Hinge { .. }
                 | ElementKind::UJoint { .. }
                 | ElementKind::Spherical

@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 10] = [
+        const TYPES: [&str; 11] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -40,6 +40,7 @@ impl Builder<'_> {
             "RIGID",
             "CAME",
             "PRESCRIBED",
+            "CLEARANCE",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -241,6 +242,15 @@ impl Builder<'_> {
             "PRESCRIBED" => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)
+            }
+            "CLEARANCE" => {
+                let bearing = c.uint("bearing node number")?;
+                let journal = c.uint("journal node number")?;
+                let data = Self::clearance(&mut c)?;
+                (
+                    vec![bearing, journal],
+                    ElementKind::Clearance(Box::new(data)),
+                )
             }
             _ => {
                 let cam = c.uint("cam node number")?;

@@ -3,6 +3,7 @@
 
 mod analysis;
 mod checks;
+mod clearance;
 mod cursor;
 mod drives;
 mod elements;

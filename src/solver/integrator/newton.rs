@@ -79,7 +79,7 @@ impl Integrator {
     /// left unchanged and a diagnosis is returned.
     pub fn try_step(&mut self, h: f64) -> Result<StepInfo, Failure> {
         let t1 = self.t + h;
-        let p = self.hht;
+        let p = self.params;
         // Rescale multipliers to this step's constraint scale.
         let s_new = if self.dynamic {
             self.scale_for(h)
@@ -92,14 +92,18 @@ impl Integrator {
         for l in &mut self.trial_lambda[nn..] {
             *l *= ratio;
         }
-        // Predictor: constant true acceleration (dynamics) or no increment (statics).
+        // Predictor: constant true acceleration (dynamics): `v̇_{n+1} = v̇_n`, so
+        // `a_{n+1} = (v̇_n − α_m a_n)/(1 − α_m)` (HHT: `a_{n+1} = v̇_n`, exactly); or no
+        // increment (statics).
         for i in 0..self.nodes.len() {
             let s = &self.nodes[i];
             self.u[i] = if self.dynamic {
                 let [a0x, a0r] = self.pseudo[i];
+                let m = 1.0 - p.alpha_m;
+                let (a1x, a1r) = ((s.a - a0x * p.alpha_m) / m, (s.wd - a0r * p.alpha_m) / m);
                 [
-                    s.v * h + (a0x * (0.5 - p.beta) + s.a * p.beta) * (h * h),
-                    s.w * h + (a0r * (0.5 - p.beta) + s.wd * p.beta) * (h * h),
+                    s.v * h + (a0x * (0.5 - p.beta) + a1x * p.beta) * (h * h),
+                    s.w * h + (a0r * (0.5 - p.beta) + a1r * p.beta) * (h * h),
                 ]
             } else {
                 [Vector3::zeros(); 2]
