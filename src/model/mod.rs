@@ -7,6 +7,7 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+mod expr;
 mod function;
 mod ids;
 mod mesh;
@@ -14,7 +15,8 @@ pub mod order;
 mod output;
 mod summary;
 
-pub use function::Function;
+pub use expr::{BinOp, Expr, Func, TimeExpr};
+pub use function::{CubicSpline, Function, SplineError};
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};

@@ -5,6 +5,7 @@ mod analysis;
 mod checks;
 mod cursor;
 mod elements;
+mod functions;
 mod nodes;
 mod properties;
 
@@ -54,6 +55,8 @@ struct Builder<'s> {
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
+    /// The parameters in force (for the expressions of `t` of EXPR functions).
+    parameters: IndexMap<String, f64>,
 }
 
 impl<'s> Builder<'s> {
@@ -142,6 +145,7 @@ pub(crate) fn build_model(
         modes: None,
         output: None,
         divide: Vec::new(),
+        parameters,
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -204,6 +208,7 @@ pub(crate) fn build_model(
         }
         return Err(b.errors);
     };
+    b.check_functions(&analysis);
     if !b.errors.is_empty() {
         return Err(b.errors);
     }
@@ -221,7 +226,7 @@ pub(crate) fn build_model(
         modes: b.modes,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
-        parameters,
+        parameters: b.parameters,
         order_nodes: IndexMap::new(),
     };
     // Generated numbers start past every user number: divide once all are known.
