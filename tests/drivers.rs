@@ -310,7 +310,12 @@ fn bad_drivers_are_located_deck_errors() {
             "a second DRIVE",
         ),
         (" 1 PRESCRIBED 3 X FUNCTION 1", 10, 15, "fixed in X"),
-        (" 1 PRISMATIC 1 2 AXIS 1 0 0 DRIVE 3", 10, 35, "is 0.5 at t = 0"),
+        (
+            " 1 PRISMATIC 1 2 AXIS 1 0 0 DRIVE 3",
+            10,
+            35,
+            "is 0.5 at t = 0",
+        ),
         (
             " 1 PRESCRIBED 2 Y FUNCTION 1\n 2 PRESCRIBED 2 Y FUNCTION 1 AMPLITUDE 2",
             11,

@@ -266,6 +266,32 @@ pub enum DeckErrorKind {
         /// The previous time as written.
         previous: String,
     },
+    /// A SPLINE with an odd number of values.
+    #[error("SPLINE values come in pairs `t f`: found {count} values (an odd number)")]
+    OddSpline {
+        /// Number of values.
+        count: usize,
+    },
+    /// Points that do not make a spline (too few, times not increasing).
+    #[error("SPLINE: {reason}")]
+    BadSpline {
+        /// Why.
+        reason: crate::model::SplineError,
+    },
+    /// An EXPR function whose value or derivatives are not finite in the analysis's span.
+    #[error(
+        "function {id}: `{text}` or one of its first two time derivatives is not finite at t = {t} s (checked at 1001 instants of the analysis's span [0, {end}] s)"
+    )]
+    FunctionNotFinite {
+        /// The function's number.
+        id: u32,
+        /// The expression.
+        text: String,
+        /// The first instant found.
+        t: f64,
+        /// The analysis's end time (1 for a static one).
+        end: f64,
+    },
     /// An expression that does not parse.
     #[error("bad expression `{text}`: expected {expected}, found {found}")]
     BadExpression {
@@ -288,7 +314,7 @@ pub enum DeckErrorKind {
     },
     /// A function that expressions do not have.
     #[error(
-        "unknown function `{name}` in `{text}`: expected one of sqrt, sin, cos, exp, log, abs (or pi)"
+        "unknown function `{name}` in `{text}`: expected one of sqrt, sin, cos, exp, log, abs (or pi; t, the time, only in a FUNCTIONS EXPR)"
     )]
     UnknownFunction {
         /// The name.
@@ -436,11 +462,16 @@ impl DeckError {
             | K::PlaneParallel
             | K::UJointNotPerpendicular { .. } => "mecano::deck::axis",
             K::OutOfRange { .. } => "mecano::deck::range",
-            K::OddTable { .. } | K::DecreasingTime { .. } => "mecano::deck::table",
+            K::OddTable { .. }
+            | K::DecreasingTime { .. }
+            | K::OddSpline { .. }
+            | K::BadSpline { .. } => "mecano::deck::table",
             K::BadExpression { .. } | K::UnknownFunction { .. } | K::ExpressionTooDeep { .. } => {
                 "mecano::deck::expression"
             }
-            K::ExpressionNotFinite { .. } => "mecano::deck::expression_value",
+            K::ExpressionNotFinite { .. } | K::FunctionNotFinite { .. } => {
+                "mecano::deck::expression_value"
+            }
             K::UndefinedParameter { .. } | K::UnknownOverride { .. } => {
                 "mecano::deck::undefined_parameter"
             }
@@ -530,7 +561,9 @@ impl DeckErrorKind {
                 cut(found);
                 cut(previous);
             }
-            K::BadExpression { text, .. } | K::ExpressionTooDeep { text, .. } => cut(text),
+            K::BadExpression { text, .. }
+            | K::ExpressionTooDeep { text, .. }
+            | K::FunctionNotFinite { text, .. } => cut(text),
             K::ExpressionNotFinite { text, what } => {
                 cut(text);
                 cut(what);

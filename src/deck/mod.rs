@@ -294,7 +294,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "SPLINE",
         "ELEMENTS",
-        "CAME profile: a cubic spline through points",
+        "CAME profile: a cubic spline through points (FUNCTIONS: the C² time function)",
     ),
     kw(
         "CLOSED",
@@ -381,6 +381,39 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "HAVERSINE",
         "FUNCTIONS",
         "a smooth pulse sin²(π(t−t0)/T) on [t0, t0+T]",
+    ),
+    kw(
+        "SLOPES",
+        "FUNCTIONS",
+        "SPLINE: clamped end slopes (default: natural ends)",
+    ),
+    kw("SINE", "FUNCTIONS", "A sin(ω(t − t0) + φ)"),
+    kw("COSINE", "FUNCTIONS", "A cos(ω(t − t0) + φ)"),
+    kw("FREQ", "FUNCTIONS", "SINE/COSINE: frequency, Hz"),
+    kw(
+        "OMEGA",
+        "FUNCTIONS",
+        "SINE/COSINE: circular frequency, rad/s",
+    ),
+    kw(
+        "PHASE",
+        "FUNCTIONS",
+        "SINE/COSINE: phase φ, rad (default 0)",
+    ),
+    kw(
+        "START",
+        "FUNCTIONS",
+        "SINE/COSINE: start time t0, s (0 before it)",
+    ),
+    kw(
+        "RAMP",
+        "FUNCTIONS",
+        "quintic C² step from (t0, f0) to (t1, f1)",
+    ),
+    kw(
+        "EXPR",
+        "FUNCTIONS",
+        "an expression of t (exact derivatives)",
     ),
     // loads
     kw("GRAVITY", "LOADS", "gravity acceleration vector, m/s²"),

@@ -70,6 +70,16 @@ fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
     }
 }
 
+/// ` t f` pairs, eight to a line (continued with `&`: a line holds at most 16 KiB).
+fn points(s: &mut String, pts: &[(f64, f64)]) {
+    for (k, (t, v)) in pts.iter().enumerate() {
+        if k > 0 && k % 8 == 0 {
+            s.push_str(" &\n   ");
+        }
+        let _ = write!(s, " {t:?} {v:?}");
+    }
+}
+
 /// Writes `model` as a deck in canonical form: `parse_deck(&write_deck(&m), _)` gives `m`
 /// back (spans aside) for every model `parse_deck` can produce.
 pub fn write_deck(model: &Model) -> String {
@@ -137,10 +147,40 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 Function::Table(pts) => {
                     let _ = write!(s, "  {} TABLE", f.id.0);
-                    for (t, v) in pts {
-                        let _ = write!(s, " {t:?} {v:?}");
+                    points(&mut s, pts);
+                    s.push('\n');
+                }
+                Function::Spline(sp) => {
+                    let _ = write!(s, "  {} SPLINE", f.id.0);
+                    points(&mut s, sp.points());
+                    if let Some((s0, sn)) = sp.slopes() {
+                        let _ = write!(s, " SLOPES {s0:?} {sn:?}");
                     }
                     s.push('\n');
+                }
+                Function::Harmonic {
+                    cosine,
+                    amplitude,
+                    omega,
+                    phase,
+                    start,
+                } => {
+                    let kind = if *cosine { "COSINE" } else { "SINE" };
+                    let _ = write!(s, "  {} {kind} {amplitude:?} OMEGA {omega:?}", f.id.0);
+                    if *phase != 0.0 {
+                        let _ = write!(s, " PHASE {phase:?}");
+                    }
+                    if let Some(t0) = start {
+                        let _ = write!(s, " START {t0:?}");
+                    }
+                    s.push('\n');
+                }
+                Function::Ramp { t0, f0, t1, f1 } => {
+                    let _ = writeln!(s, "  {} RAMP {t0:?} {f0:?} {t1:?} {f1:?}", f.id.0);
+                }
+                Function::Expr(e) => {
+                    // As written: the same field reads back to the same tree.
+                    let _ = writeln!(s, "  {} EXPR {}", f.id.0, e.text);
                 }
             }
         }

@@ -9,6 +9,7 @@
 pub mod arc;
 mod clearance;
 mod drive;
+mod expr;
 mod function;
 mod ids;
 mod mesh;
@@ -20,7 +21,8 @@ mod summary;
 
 pub use clearance::{ClearanceData, ContactLaw};
 pub use drive::{Drive, NodeMotion};
-pub use function::Function;
+pub use expr::{BinOp, Expr, Func, TimeExpr};
+pub use function::{CubicSpline, Function, SplineError};
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};

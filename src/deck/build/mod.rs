@@ -7,6 +7,7 @@ mod clearance;
 mod cursor;
 mod drives;
 mod elements;
+mod functions;
 mod nodes;
 mod properties;
 mod section;
@@ -59,6 +60,8 @@ struct Builder<'s> {
     divide: Vec<(ElementId, u32, Span)>,
     /// Driven joints (`DRIVE` on a HINGE or PRISMATIC card).
     drives: IndexMap<ElementId, crate::model::Drive>,
+    /// The parameters in force (for the expressions of `t` of EXPR functions).
+    parameters: IndexMap<String, f64>,
 }
 
 impl<'s> Builder<'s> {
@@ -148,6 +151,7 @@ pub(crate) fn build_model(
         output: None,
         divide: Vec::new(),
         drives: IndexMap::new(),
+        parameters,
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -210,6 +214,7 @@ pub(crate) fn build_model(
         }
         return Err(b.errors);
     };
+    b.check_functions(&analysis);
     if !b.errors.is_empty() {
         return Err(b.errors);
     }
@@ -227,7 +232,7 @@ pub(crate) fn build_model(
         modes: b.modes,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
-        parameters,
+        parameters: b.parameters,
         order_nodes: IndexMap::new(),
         drives: b.drives,
     };
