@@ -208,3 +208,14 @@ fn drivers_restart_bit_for_bit() {
         &[0.3, 0.3334, 0.5],
     );
 }
+
+#[test]
+fn clearance_joint_restarts_bit_for_bit() {
+    // A journal bouncing and rolling in its bearing (touches, restarts of the
+    // accelerations, releases, the approach speed of each impact, friction).
+    check_restarts(
+        "clearance_orbit",
+        &deck("clearance_orbit.dat"),
+        &[0.2, 0.5, 0.8],
+    );
+}

@@ -80,6 +80,9 @@ pub struct Clearance {
     /// Approach speed `δ̇⁻` of the current impact (Lankarani–Nikravesh), m/s.
     approach: f64,
     impacts: u64,
+    /// Steps accepted in contact though longer than the impact resolution asks (the run
+    /// could not cut them: MINSTEP), reported in the summary.
+    unresolved: u64,
     max_penetration: f64,
     max_force: f64,
     dissipated: f64,
@@ -99,6 +102,7 @@ pub struct ClearanceState {
     active: bool,
     approach: f64,
     impacts: u64,
+    unresolved: u64,
     max_penetration: f64,
     max_force: f64,
     dissipated: f64,
@@ -161,6 +165,7 @@ impl Clearance {
             active: false,
             approach: d.min_approach.max(1e-300),
             impacts: 0,
+            unresolved: 0,
             max_penetration: 0.0,
             max_force: 0.0,
             dissipated: 0.0,

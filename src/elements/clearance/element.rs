@@ -2,6 +2,7 @@
 //! numbers), energies, commits of the contact history, checkpoints and output rows.
 
 use super::{Clearance, ClearanceState};
+use crate::elements::came::LIMIT_SLACK;
 use crate::elements::{
     Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, StepLimit,
 };
@@ -123,6 +124,10 @@ impl Element for Clearance {
                 self.omega = w;
             }
         }
+        if ctx.dynamic && was && self.touching && ctx.h > LIMIT_SLACK * self.impact_step(self.omega)
+        {
+            self.unresolved += 1;
+        }
         self.last_power = if self.restart && self.touching {
             self.power(&st)
         } else {
@@ -142,6 +147,7 @@ impl Element for Clearance {
             active: self.active,
             approach: self.approach,
             impacts: self.impacts,
+            unresolved: self.unresolved,
             max_penetration: self.max_penetration,
             max_force: self.max_force,
             dissipated: self.dissipated,
@@ -162,6 +168,7 @@ impl Element for Clearance {
         self.active = s.active;
         self.approach = s.approach;
         self.impacts = s.impacts;
+        self.unresolved = s.unresolved;
         self.max_penetration = s.max_penetration;
         self.max_force = s.max_force;
         self.dissipated = s.dissipated;
@@ -224,6 +231,7 @@ impl Element for Clearance {
     fn summary(&self) -> Option<serde_json::Value> {
         Some(serde_json::json!({
             "impacts": self.impacts,
+            "unresolved_steps": self.unresolved,
             "max_penetration": self.max_penetration,
             "max_normal_force": self.max_force,
             "dissipated_energy": self.dissipated,

@@ -75,7 +75,7 @@ impl Clearance {
     }
 
     /// The impact step `π/(ω · IMPACT_STEPS)` for a contact frequency (∞ when unknown).
-    fn impact_step(&self, omega: f64) -> f64 {
+    pub(super) fn impact_step(&self, omega: f64) -> f64 {
         if omega > 0.0 {
             PI / (omega * f64::from(self.impact_steps))
         } else {
