@@ -640,4 +640,10 @@ pub fn strip_spans(model: &mut Model) {
     model.elements.values_mut().for_each(|x| x.span = zero);
     model.loads.iter_mut().for_each(|x| x.span = zero);
     model.initial.iter_mut().for_each(|x| x.span = zero);
+    model.drives.values_mut().for_each(|x| x.span = zero);
+    for e in model.elements.values_mut() {
+        if let crate::model::ElementKind::Prescribed { drive, .. } = &mut e.kind {
+            drive.span = zero;
+        }
+    }
 }

@@ -40,3 +40,19 @@ impl NodeMotion {
         }
     }
 }
+
+impl super::Model {
+    /// The functions the model's drivers follow (driven joints, `PRESCRIBED` elements):
+    /// their breakpoints are where a driver's acceleration may jump.
+    pub fn driver_functions(&self) -> Vec<&super::Function> {
+        let prescribed = self.elements.values().filter_map(|e| match &e.kind {
+            super::ElementKind::Prescribed { drive, .. } => Some(drive),
+            _ => None,
+        });
+        self.drives
+            .values()
+            .chain(prescribed)
+            .filter_map(|d| self.functions.get(&d.function).map(|f| &f.function))
+            .collect()
+    }
+}

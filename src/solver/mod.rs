@@ -314,6 +314,17 @@ pub fn run_from(
         .flat_map(|f| f.breakpoints())
         .filter(|t| *t > 0.0 && *t < end)
         .collect();
+    // Drivers' breakpoints too: there a prescribed acceleration may jump (the haversine's
+    // ends), and the accelerations restart from the law's new value once a step lands on
+    // one (as after a contact's touch: no step straddles the jump).
+    let mut drive_breaks: Vec<f64> = model
+        .driver_functions()
+        .iter()
+        .flat_map(|f| f.breakpoints())
+        .filter(|t| *t > 0.0 && *t < end)
+        .collect();
+    drive_breaks.sort_by(f64::total_cmp);
+    breaks.extend_from_slice(&drive_breaks);
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();
     let ctl = resume.unwrap_or(LoopState {
@@ -394,6 +405,12 @@ pub fn run_from(
                     h: h_try,
                 })?;
                 obs.progress(integ.t, end, &integ.stats);
+                if integ.dynamic
+                    && drive_breaks.iter().any(|b| (integ.t - b).abs() <= near)
+                    && integ.consistent_accelerations().is_ok()
+                {
+                    integ.stats.restarts += 1;
+                }
                 good += 1;
                 if adaptive {
                     // The local error estimate proposes the next step; it is taken from

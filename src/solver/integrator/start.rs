@@ -216,15 +216,18 @@ impl Integrator {
 
 impl Integrator {
     /// Adds `−s ∂^{order}Φ/∂t^{order}` of every driver's constraint rows to `rhs` (order 1:
-    /// the velocity level `s(Bv + Φ_t) = 0`, order 2: the acceleration level).
+    /// the velocity level `s(Bv + Φ_t) = 0`, order 2: the acceleration level). The laws
+    /// are read just after `t` (by 1e-12 of max(1, |t|) s): at a breakpoint of a law (where
+    /// the run restarts the accelerations) the value after its jump is the one that holds.
     fn add_time_derivatives(&self, rhs: &mut [f64], order: usize, s: f64) {
+        let t = self.t + 1e-12 * self.t.abs().max(1.0);
         for (e, el) in self.sys.elements.iter().enumerate() {
             if !el.rheonomic() {
                 continue;
             }
             let o = self.sys.mult_offset[e];
             for k in 0..el.multipliers() {
-                rhs[o + k] -= s * el.constraint_time_derivatives(self.t, k)[order - 1];
+                rhs[o + k] -= s * el.constraint_time_derivatives(t, k)[order - 1];
             }
         }
     }
