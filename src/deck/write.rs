@@ -283,6 +283,7 @@ pub fn write_deck(model: &Model) -> String {
                 max_step,
                 adaptive,
                 newton,
+                scheme,
             },
             None,
         ) => {
@@ -296,6 +297,9 @@ pub fn write_deck(model: &Model) -> String {
                     " ADAPTIVE TOLPOS {:?} TOLROT {:?} GROWTH {:?}",
                     a.tol_position, a.tol_rotation, a.max_growth
                 );
+            }
+            if *scheme == crate::model::Scheme::Esdirk3 {
+                let _ = write!(s, " ESDIRK3");
             }
             let _ = writeln!(
                 s,

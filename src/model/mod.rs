@@ -322,6 +322,17 @@ pub struct Adaptive {
     pub max_growth: f64,
 }
 
+/// The time integrator of a dynamic analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Scheme {
+    /// HHT-α (Hilber, Hughes & Taylor 1977) on the Lie group: second order.
+    #[default]
+    Hht,
+    /// The third-order, L-stable ESDIRK3(2)4L[2]SA of Kennedy & Carpenter (2016) on the Lie
+    /// group (`solver::integrator::esdirk`): three implicit stages per step.
+    Esdirk3,
+}
+
 /// The analysis to run.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Analysis {
@@ -341,6 +352,8 @@ pub enum Analysis {
         adaptive: Option<Adaptive>,
         /// Newton settings.
         newton: NewtonSettings,
+        /// The time integrator (`ESDIRK3` on the card; HHT by default).
+        scheme: Scheme,
     },
     /// Static equilibrium with load steps (loads scaled by their functions at
     /// `t = i / steps`, i = 1..steps).

@@ -131,6 +131,9 @@ pub struct Integrator {
     /// Newton residual history of the step under way (kept between steps so that a
     /// successful step allocates nothing; handed to the [`Failure`] of a failed one).
     history: Vec<f64>,
+    /// The stages of the ESDIRK scheme when it replaces HHT ([`Integrator::use_esdirk3`]);
+    /// `None` = HHT. Scratch within a step: nothing in it is read across steps.
+    esdirk: Option<Box<esdirk::Stages>>,
     /// Buffers of [`Integrator::consistent_accelerations`], kept so that the restarts of
     /// the accelerations at a contact's events allocate nothing (issue 27 §1d).
     acc: AccelerationScratch,
@@ -200,6 +203,7 @@ impl Integrator {
             tmap: vec![nalgebra::Matrix3::identity(); nn],
             history: Vec::with_capacity(newton.max_iterations as usize + 1),
             acc: AccelerationScratch::sized(n, n - sys.n_node_eq, nn),
+            esdirk: None,
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -304,6 +308,7 @@ impl Integrator {
 }
 
 mod error;
+pub mod esdirk;
 mod hht;
 mod newton;
 mod start;

@@ -214,8 +214,17 @@ pub enum RunError {
 pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     let sys = System::new(model)?;
     let mut integ = match &model.analysis {
-        Analysis::Dynamic { alpha, newton, .. } => {
-            Integrator::new(sys, newton.clone(), *alpha, true)
+        Analysis::Dynamic {
+            alpha,
+            newton,
+            scheme,
+            ..
+        } => {
+            let mut integ = Integrator::new(sys, newton.clone(), *alpha, true);
+            if *scheme == crate::model::Scheme::Esdirk3 {
+                integ.use_esdirk3();
+            }
+            integ
         }
         Analysis::Static { newton, .. } => Integrator::new(sys, newton.clone(), 0.0, false),
     };

@@ -2,6 +2,7 @@
 
 use super::cursor::*;
 use super::*;
+use crate::model::Scheme;
 
 impl Builder<'_> {
     // ---------------------------------------------------------------- LOADS
@@ -130,7 +131,7 @@ impl Builder<'_> {
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
                 "ALPHA", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT",
-                "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
+                "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON", "ESDIRK3",
             ]
         } else {
             &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
@@ -141,6 +142,7 @@ impl Builder<'_> {
         let (mut step, mut end, mut min, mut max) = (None, None, None, None);
         let (mut tolpos, mut tolrot, mut growth, mut steps) = (None, None, 2.0, 1);
         let mut adaptive = None;
+        let mut scheme = Scheme::Hht;
         let pos = |v: f64| v > 0.0;
         while let Some(t) = c.peek() {
             let Some((kw, ks)) = c.keyword(kws) else {
@@ -158,6 +160,7 @@ impl Builder<'_> {
                 "MINSTEP" => min = Some(c.number("MINSTEP (smallest step)")?),
                 "MAXSTEP" => max = Some(c.number("MAXSTEP (largest step)")?),
                 "ADAPTIVE" => adaptive = Some(ks),
+                "ESDIRK3" => scheme = Scheme::Esdirk3,
                 "TOLPOS" => tolpos = Some(c.number_in("TOLPOS", "> 0 m", pos)?),
                 "TOLROT" => tolrot = Some(c.number_in("TOLROT", "> 0 rad", pos)?),
                 "GROWTH" => growth = c.number_in("GROWTH", ">= 1", |v| v >= 1.0)?,
@@ -245,6 +248,7 @@ impl Builder<'_> {
                 max_step,
                 adaptive,
                 newton,
+                scheme,
             }
         };
         self.set_analysis(analysis, span)
