@@ -307,6 +307,18 @@ impl Integrator {
     }
 }
 
+/// `nodes` moved along their velocities for a time `dt` (the geodesic `q exp(dt v)`:
+/// `x + v dt`, `R exp(dt Ω̃)`), into `out`: the points of the central differences of `Φ`
+/// along `v` (the restart's `Ḃv`, the ESDIRK stages' `B v`).
+fn moved_along_velocities(nodes: &[NodeState], dt: f64, out: &mut Vec<NodeState>) {
+    out.clear();
+    out.extend(nodes.iter().map(|s| NodeState {
+        x: s.x + s.v * dt,
+        r: s.r * rotation::exp(&(s.w * dt)),
+        ..*s
+    }));
+}
+
 mod error;
 pub mod esdirk;
 mod hht;

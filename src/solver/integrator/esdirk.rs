@@ -231,16 +231,8 @@ impl Integrator {
             return;
         }
         let eps = 1e-4 / vmax;
-        let moved = |sign: f64, nodes: &[NodeState], out: &mut Vec<NodeState>| {
-            out.clear();
-            out.extend(nodes.iter().map(|s| NodeState {
-                x: s.x + s.v * (sign * eps),
-                r: s.r * rotation::exp(&(s.w * (sign * eps))),
-                ..*s
-            }));
-        };
-        moved(1.0, &self.trial, &mut st.plus);
-        moved(-1.0, &self.trial, &mut st.minus);
+        moved_along_velocities(&self.trial, eps, &mut st.plus);
+        moved_along_velocities(&self.trial, -eps, &mut st.minus);
         self.sys.assemble(ctx, &st.plus, &self.trial_lambda, false);
         st.rows.copy_from_slice(&self.sys.rhs[nn..]);
         self.sys.assemble(ctx, &st.minus, &self.trial_lambda, false);
