@@ -12,11 +12,17 @@ use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Vector3};
 
 fn esdirk(model: &mut Model, h: f64, end: f64) {
-    assert!(model.set_fixed_step(h, end, None), "dynamic deck expected");
-    match &mut model.analysis {
-        Analysis::Dynamic { scheme, .. } => *scheme = Scheme::Esdirk3,
-        Analysis::Static { .. } => unreachable!(),
-    }
+    assert!(
+        model.set_fixed_step(h, end, Some(Scheme::Esdirk3)),
+        "dynamic deck expected"
+    );
+    assert!(matches!(
+        model.analysis,
+        Analysis::Dynamic {
+            scheme: Scheme::Esdirk3,
+            ..
+        }
+    ));
 }
 
 fn node(model: &Model, id: u32) -> usize {

@@ -3,10 +3,13 @@
 
 mod analysis;
 mod checks;
+mod clearance;
 mod cursor;
+mod drives;
 mod elements;
 mod nodes;
 mod properties;
+mod section;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
@@ -54,6 +57,8 @@ struct Builder<'s> {
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
+    /// Driven joints (`DRIVE` on a HINGE or PRISMATIC card).
+    drives: IndexMap<ElementId, crate::model::Drive>,
 }
 
 impl<'s> Builder<'s> {
@@ -142,6 +147,7 @@ pub(crate) fn build_model(
         modes: None,
         output: None,
         divide: Vec::new(),
+        drives: IndexMap::new(),
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -223,6 +229,7 @@ pub(crate) fn build_model(
         divisions: IndexMap::new(),
         parameters,
         order_nodes: IndexMap::new(),
+        drives: b.drives,
     };
     // Generated numbers start past every user number: divide once all are known.
     let mut numbering = crate::model::Numbering::after(&model);

@@ -49,11 +49,27 @@ pub const A: [[f64; 4]; 4] = [
     ],
     [
         0.187_641_024_346_723_8,
-        -0.595_297_473_576_954_9,
+        -0.595_297_473_576_955,
         0.971_789_927_721_772_1,
         GAMMA,
     ],
 ];
+
+/// The stability function `R(z) = 1 + z bᵀ(I − zA)⁻¹1` (the step's amplification of
+/// `y' = λy`, `z = λh`), stage by stage since `A` is lower triangular:
+/// `Y_i = (1 + z Σ_{j<i} a_ij Y_j)/(1 − z a_ii)`, `R = Y_4` (stiffly accurate).
+pub fn stability(z: nalgebra::Complex<f64>) -> nalgebra::Complex<f64> {
+    let one = nalgebra::Complex::new(1.0, 0.0);
+    let mut y = [one; S];
+    for i in 0..S {
+        let mut s = one;
+        for j in 0..i {
+            s += z * A[i][j] * y[j];
+        }
+        y[i] = s / (one - z * A[i][i]);
+    }
+    y[S - 1]
+}
 
 /// Number of stages.
 const S: usize = 4;
@@ -84,7 +100,7 @@ pub struct Stages {
 }
 
 impl Stages {
-    fn sized(nodes: usize) -> Self {
+    pub(super) fn sized(nodes: usize) -> Self {
         let z = [Vector3::zeros(); 2];
         Stages {
             vel: vec![[z; S]; nodes],
@@ -101,11 +117,6 @@ impl Stages {
 }
 
 impl Integrator {
-    /// Integrates with the ESDIRK scheme (module docs) instead of HHT from now on.
-    pub fn use_esdirk3(&mut self) {
-        self.esdirk = Some(Box::new(Stages::sized(self.nodes.len())));
-    }
-
     /// Whether the ESDIRK scheme integrates (else HHT).
     pub fn is_esdirk3(&self) -> bool {
         self.esdirk.is_some()
@@ -206,7 +217,7 @@ impl Integrator {
         }
     }
 
-    /// The constraint rows of an inner stage, `s γh B(q_i) v_i` (module docs), into the
+    /// The constraint rows of an inner stage, `s γh (B(q_i) v_i + ∂Φ/∂t)` (module docs), into the
     /// stages' `rows`: `B v` is the derivative of `Φ` along `q exp(εv)`, by a central
     /// difference with `ε|v| = 1e-4 L_ref` (truncation `ε²|v|³Φ‴/6`: 1e-8 of `|v|` for a
     /// constraint of curvature 1/L_ref; round-off `ε_mach L_ref/ε`: 1e-12 of `|v|`).
@@ -227,15 +238,25 @@ impl Integrator {
             .fold(0.0f64, |m, s| m.max(s.v.norm() / l).max(s.w.norm()));
         st.rows.clear();
         st.rows.resize(n - nn, 0.0);
-        if vmax == 0.0 {
-            return;
-        }
-        let eps = 1e-4 / vmax;
+        // At rest the difference is along time alone (a driver's ∂Φ/∂t), over 1e-4 of the step.
+        let eps = if vmax > 0.0 {
+            1e-4 / vmax
+        } else {
+            1e-4 * st.gh
+        };
         moved_along_velocities(&self.trial, eps, &mut st.plus);
         moved_along_velocities(&self.trial, -eps, &mut st.minus);
-        self.sys.assemble(ctx, &st.plus, &self.trial_lambda, false);
+        // Time moves with the state, so a driven (rheonomic) constraint's rows are its
+        // total derivative `B v + ∂Φ/∂t`.
+        let at = |dt: f64| EvalContext {
+            t: ctx.t + dt,
+            ..*ctx
+        };
+        self.sys
+            .assemble(&at(eps), &st.plus, &self.trial_lambda, false);
         st.rows.copy_from_slice(&self.sys.rhs[nn..]);
-        self.sys.assemble(ctx, &st.minus, &self.trial_lambda, false);
+        self.sys
+            .assemble(&at(-eps), &st.minus, &self.trial_lambda, false);
         let c = st.gh / (2.0 * eps);
         for (r, m) in st.rows.iter_mut().zip(&self.sys.rhs[nn..]) {
             *r = (*r - m) * c;
