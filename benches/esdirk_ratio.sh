@@ -22,17 +22,17 @@ bin=target/release/mecano-rs
 mkdir -p "$out"
 
 # A flexible1 deck with each bar ONE beam card `DIVIDE d ORDER p`, step h, output every k
-# steps, and extra ANALYSIS keywords.
-mk() { # name divide order step every extra
+# steps, and the integrator's ANALYSIS keywords.
+mk() { # name divide order step every integrator
   sed -e "s/^  2 TO 12 LINE  0 0 0   1 0 0/  2 0 0 0\n  12 1 0 0/" \
     -e "s/^  13 TO 23 LINE  1 0 0   1.8660254037844386 0 0.5/  13 1 0 0\n  23 1.8660254037844386 0 0.5/" \
     -e "s/^  2 TO 11  BEAM 2 3  MAT 1 SEC 1/  2 BEAM 2 12 MAT 1 SEC 1 DIVIDE $2 ORDER $3/" \
     -e "s/^  13 TO 22 BEAM 13 14  MAT 1 SEC 1/  13 BEAM 13 23 MAT 1 SEC 1 DIVIDE $2 ORDER $3/" \
-    -e "s/STEP 1e-4 END 2.0/STEP $4 END 1.5 $6/" -e "s/EVERY 10/EVERY $5/" \
+    -e "s/ALPHA -0.1 STEP 1e-4 END 2.0/$6 STEP $4 END 1.5/" -e "s/EVERY 10/EVERY $5/" \
     decks/pendulum_flexible1.dat >"$out/$1.dat"
 }
-mk ref 2 8 3.90625e-6 20 ""
-mk hht 1 8 1.5625e-5 5 ""
+mk ref 2 8 3.90625e-6 20 "ALPHA -0.1"
+mk hht 1 8 1.5625e-5 5 "ALPHA -0.1"
 mk esdirk 1 8 "$he" "$every" ESDIRK3
 
 [ -f "$out/out_ref/summary.json" ] || "$bin" "$out/ref.dat" -o "$out/out_ref" --quiet --checkpoint 0

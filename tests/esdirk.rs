@@ -381,7 +381,7 @@ fn long_runs_stay_bounded() {
 fn a_diverging_run_fails_cleanly() {
     let scratch = common::TempDir::new("esdirk_diverge");
     let text = std::fs::read_to_string(common::deck_path("stab_diverge.dat")).unwrap();
-    let text = text.replace("ANALYSIS DYNAMIC", "ANALYSIS DYNAMIC ESDIRK3");
+    let text = text.replace("ANALYSIS DYNAMIC ALPHA -0.1", "ANALYSIS DYNAMIC ESDIRK3");
     assert!(text.contains("ESDIRK3"));
     let deck = scratch.join("diverge.dat");
     std::fs::write(&deck, text).unwrap();
