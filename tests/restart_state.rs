@@ -115,6 +115,22 @@ fn joints_restart_bit_for_bit() {
     check_restarts("ujoint_singular", &deck("ujoint_singular.dat"), &[0.3, 0.6]);
 }
 
+/// The ESDIRK3 integrator keeps nothing across steps but what HHT keeps (its stages are
+/// scratch): a bounce (touch, restart, release) and joints restart bit for bit with it.
+#[test]
+fn esdirk_restarts_bit_for_bit() {
+    for (name, at) in [
+        ("contact_bounce", &[0.2, 0.5, 0.8][..]),
+        ("double_pendulum_beams", &[0.25, 0.6][..]),
+    ] {
+        let mut m = deck(&format!("{name}.dat"));
+        if let Analysis::Dynamic { scheme, .. } = &mut m.analysis {
+            *scheme = mecano::model::Scheme::Esdirk3;
+        }
+        check_restarts(name, &m, at);
+    }
+}
+
 #[test]
 fn adaptive_steps_restart_bit_for_bit() {
     // The step ladder, the error estimate's proposal and a contact's step limits.

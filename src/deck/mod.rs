@@ -453,6 +453,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     ),
     kw("STEP", "ANALYSIS", "time step, s (> 0)"),
     kw(
+        "ESDIRK3",
+        "ANALYSIS",
+        "third-order L-stable ESDIRK time integrator instead of HHT",
+    ),
+    kw(
         "MINSTEP",
         "ANALYSIS",
         "smallest step when cutting, s (default STEP/1024)",

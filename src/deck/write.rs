@@ -362,6 +362,7 @@ pub fn write_deck(model: &Model) -> String {
                 Scheme::GeneralizedAlpha { rho_inf } => {
                     write!(s, "ANALYSIS DYNAMIC GENALPHA RHOINF {rho_inf:?}")
                 }
+                Scheme::Esdirk3 => write!(s, "ANALYSIS DYNAMIC ESDIRK3"),
             };
             let _ = write!(
                 s,
