@@ -17,11 +17,14 @@
 
 pub mod beam;
 pub mod beam_p;
+pub mod bushing;
 pub mod came;
 pub mod joints;
 pub mod mass;
 pub mod profile;
 pub mod rigid_bar;
+pub mod rspring;
+pub mod spring;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -98,6 +101,9 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                 }
             }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
+            ElementKind::Spring(_) | ElementKind::Bushing(_) | ElementKind::RSpring(_) => {
+                out.push(spring::from_model(model, el)?)
+            }
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }
@@ -119,6 +125,11 @@ pub enum ElementState {
     Came(came::CameState),
     /// A joint ([`joints::Joint`]).
     Joint(joints::JointState),
+    /// A SPRING's line of action at the last accepted state ([`spring::Spring`]).
+    Spring([f64; 3]),
+    /// An RSPRING's hinge angle at the last accepted state, rad, whole turns counted
+    /// ([`rspring::RSpring`]).
+    RSpring(f64),
 }
 
 /// A saved [`ElementState`] that does not belong to the element it is given to.

@@ -12,12 +12,14 @@ mod ids;
 mod mesh;
 pub mod order;
 mod output;
+mod springs;
 mod summary;
 
 pub use function::Function;
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};
+pub use springs::{BushingData, RSpringData, SpringData, SpringLength};
 pub use summary::{Effects, Generated, Summary};
 
 use indexmap::IndexMap;
@@ -212,6 +214,12 @@ pub enum ElementKind {
     Rigid,
     /// Cam–follower contact (first node: cam, second: follower).
     Came(Box<CameData>),
+    /// Two-node spring–damper along the line of its nodes.
+    Spring(Box<SpringData>),
+    /// Six-component linear bushing (nodes 1, 2).
+    Bushing(Box<BushingData>),
+    /// Rotational spring, damper and friction on a HINGE (the hinge's nodes).
+    RSpring(Box<RSpringData>),
 }
 
 impl ElementKind {
@@ -227,6 +235,9 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => "PRISMATIC",
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
+            ElementKind::Spring(_) => "SPRING",
+            ElementKind::Bushing(_) => "BUSHING",
+            ElementKind::RSpring(_) => "RSPRING",
         }
     }
 
