@@ -71,7 +71,7 @@ pub enum DeckErrorKind {
     },
     /// An unknown element type.
     #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME"
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, SPRING, BUSHING, RSPRING"
     )]
     UnknownElementType {
         /// The word.
@@ -356,6 +356,30 @@ pub enum DeckErrorKind {
         /// Line of the first definition.
         first_line: usize,
     },
+    /// A SPRING whose nodes coincide at t = 0.
+    #[error("SPRING element {element} joins nodes {first} and {second} at zero distance: {reason}")]
+    SpringZeroLength {
+        /// The spring.
+        element: u32,
+        /// Its first node.
+        first: u32,
+        /// Its second node.
+        second: u32,
+        /// Why that is refused.
+        reason: &'static str,
+    },
+    /// An RSPRING naming an element that is not a HINGE.
+    #[error(
+        "RSPRING element {element} names element {target}, a {found}: an RSPRING acts on a HINGE"
+    )]
+    NotAHinge {
+        /// The RSPRING.
+        element: u32,
+        /// The element it names.
+        target: u32,
+        /// That element's type keyword.
+        found: &'static str,
+    },
     /// `--set name=value` (or a sweep plan) for a parameter the deck does not define.
     #[error("cannot set parameter `{name}`: the deck does not define it ({known})")]
     UnknownOverride {
@@ -428,6 +452,7 @@ impl DeckError {
             K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
                 "mecano::deck::element"
             }
+            K::SpringZeroLength { .. } | K::NotAHinge { .. } => "mecano::deck::spring",
         }
     }
 

@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 9] = [
+        const TYPES: [&str; 12] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -39,6 +39,9 @@ impl Builder<'_> {
             "PRISMATIC",
             "RIGID",
             "CAME",
+            "SPRING",
+            "BUSHING",
+            "RSPRING",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -221,6 +224,9 @@ impl Builder<'_> {
                 }
                 (ns, ElementKind::Rigid)
             }
+            "SPRING" => self.spring_card(&mut c, id)?,
+            "BUSHING" => Self::bushing_card(&mut c)?,
+            "RSPRING" => self.rspring_card(&mut c, id)?,
             _ => {
                 let cam = c.uint("cam node number")?;
                 let fol = c.uint("follower node number")?;

@@ -7,6 +7,7 @@ mod cursor;
 mod elements;
 mod nodes;
 mod properties;
+mod springs;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
@@ -54,6 +55,8 @@ struct Builder<'s> {
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
+    /// RSPRING elements' hinges (element, hinge number, its span), resolved after ELEMENTS.
+    hinge_refs: Vec<(ElementId, u32, Span)>,
 }
 
 impl<'s> Builder<'s> {
@@ -142,6 +145,7 @@ pub(crate) fn build_model(
         modes: None,
         output: None,
         divide: Vec::new(),
+        hinge_refs: Vec::new(),
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -174,6 +178,7 @@ pub(crate) fn build_model(
         let r = b.element(c);
         b.push(r);
     }
+    b.resolve_hinges();
     for c in of(Section::Loads) {
         let r = b.load(c);
         b.push(r);
