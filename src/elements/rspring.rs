@@ -106,7 +106,8 @@ impl RSpring {
 
     /// Whether `Q p` is (nearly) parallel to the axis: no angle.
     fn degenerate(s: f64, co: f64) -> bool {
-        !(s * s + co * co > 1e-12)
+        let n2 = s * s + co * co;
+        n2.is_nan() || n2 <= 1e-12
     }
 
     fn at(&self, nodes: &[NodeState]) -> Option<At> {

@@ -104,7 +104,7 @@ impl Spring {
     /// Whether the state is at or through zero length (module docs).
     fn degenerate(&self, d: &Vector3<f64>) -> bool {
         let l = d.norm();
-        !(l > 1e-9 * self.l_scale) || d.dot(&self.direction) <= 0.0
+        l.is_nan() || l <= 1e-9 * self.l_scale || d.dot(&self.direction) <= 0.0
     }
 
     fn kin(&self, nodes: &[NodeState]) -> Kin {
