@@ -60,6 +60,11 @@ fn crossing_frequency(t: &[f64], s: &[f64]) -> f64 {
 fn assert_frequency(what: &str, measured: f64, omega: f64, h: f64) {
     let lo = omega * (1.0 - (omega * h).powi(2) / 12.0 - 1e-6);
     let hi = omega * (1.0 + 1e-6);
+    eprintln!(
+        "{what}: measured {measured} rad/s, closed form {omega}, relative {:.3e}, bound (ωh)²/12 = {:.3e}",
+        measured / omega - 1.0,
+        (omega * h).powi(2) / 12.0
+    );
     assert!(
         (lo..=hi).contains(&measured),
         "{what}: measured {measured} rad/s, closed form {omega} (allowed [{lo}, {hi}])"
@@ -118,6 +123,7 @@ fn damped_decay_has_the_closed_form_decrement_and_the_balance_closes() {
     let z = num / den;
     let discrete = -2.0 * PI * z.norm().ln() / z.arg();
     let tol = (discrete - closed).abs() + 1e-5 * closed;
+    eprintln!("decrement: measured {measured}, closed form {closed}, scheme {discrete}");
     assert!(
         (measured - closed).abs() <= tol,
         "decrement {measured}, closed form {closed}, scheme's {discrete} (tolerance {tol})"
@@ -132,6 +138,7 @@ fn damped_decay_has_the_closed_form_decrement_and_the_balance_closes() {
     );
     let gap = (h.energy[last] + d - h.energy[0]).abs();
     let tol = 1.5 * (omega * hstep).powi(2) / 4.0 * d;
+    eprintln!("balance: gap {gap:e} J of D = {d} J (tolerance {tol:e})");
     assert!(
         gap <= tol,
         "balance off by {gap} J (tolerance {tol} J, D = {d} J)"
@@ -183,6 +190,12 @@ fn static_equilibrium_of_free_length_preload_and_curve() {
         if f(mid) < mg { lo = mid } else { hi = mid }
     }
     let l_curve = length(idx(5), idx(6));
+    eprintln!(
+        "static: free {:e}, preload {:e}, curve {:e} m off",
+        l_free - (0.8 + mg / 1000.0),
+        l_pre - (1.0 + (mg - 30.0) / 2000.0),
+        l_curve - 1.0 - lo
+    );
     assert!(
         (l_curve - (1.0 + lo)).abs() < 1e-9,
         "curve: {l_curve} vs {}",
@@ -268,6 +281,10 @@ fn flywheel_spins_down_linearly_and_dissipates_its_energy() {
     let e0 = 0.5 * j * w0 * w0;
     assert!((h.energy[0] - e0).abs() < 1e-12 * e0);
     let d = h.damping_work[last];
+    eprintln!(
+        "flywheel: dissipated {d} J of {e0} J, final omega {}",
+        h.nodes[last][1].w.z
+    );
     assert!((d - e0).abs() <= 1e-5 * e0, "dissipated {d} J, want {e0} J");
     assert!((h.energy[last] + d - h.energy[0]).abs() <= 1e-5 * e0);
 }
