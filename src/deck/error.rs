@@ -71,7 +71,7 @@ pub enum DeckErrorKind {
     },
     /// An unknown element type.
     #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, SPRING, BUSHING, RSPRING"
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE, SPRING, BUSHING, RSPRING"
     )]
     UnknownElementType {
         /// The word.
@@ -196,6 +196,18 @@ pub enum DeckErrorKind {
         element: u32,
         /// What is wrong with the three points.
         reason: String,
+    },
+    /// A BEAM that names a material for a section given by its properties per unit length.
+    #[error(
+        "BEAM element {element} names material {material}, but section {section} gives its stiffness and inertia per unit length (PROPERTIES): remove MAT (a damping coefficient goes on the section card: DAMPING)"
+    )]
+    MaterialNotUsed {
+        /// Element number.
+        element: u32,
+        /// The material named.
+        material: u32,
+        /// The section of properties.
+        section: u32,
     },
     /// A zero or non-finite direction vector.
     #[error("{what} must be a non-zero finite vector, found ({x}, {y}, {z})")]
@@ -380,6 +392,14 @@ pub enum DeckErrorKind {
         /// That element's type keyword.
         found: &'static str,
     },
+    /// A driver (a `DRIVE` on a joint, a `PRESCRIBED` element) that cannot be built.
+    #[error("{context}: {reason}")]
+    BadDrive {
+        /// The card (`element 3 (UJOINT)`).
+        context: String,
+        /// What is wrong and what is accepted.
+        reason: String,
+    },
     /// `--set name=value` (or a sweep plan) for a parameter the deck does not define.
     #[error("cannot set parameter `{name}`: the deck does not define it ({known})")]
     UnknownOverride {
@@ -431,9 +451,10 @@ impl DeckError {
             K::Duplicate { .. } => "mecano::deck::duplicate",
             K::Undefined { .. } => "mecano::deck::undefined",
             K::BadGeneration { .. } => "mecano::deck::generation",
-            K::BeamSameNode { .. } | K::BeamZeroLength { .. } | K::BadArc { .. } => {
-                "mecano::deck::beam"
-            }
+            K::BeamSameNode { .. }
+            | K::BeamZeroLength { .. }
+            | K::BadArc { .. }
+            | K::MaterialNotUsed { .. } => "mecano::deck::beam",
             K::BadAxis { .. }
             | K::Axis2Parallel { .. }
             | K::PlaneParallel
@@ -453,6 +474,7 @@ impl DeckError {
                 "mecano::deck::element"
             }
             K::SpringZeroLength { .. } | K::NotAHinge { .. } => "mecano::deck::spring",
+            K::BadDrive { .. } => "mecano::deck::drive",
         }
     }
 

@@ -27,6 +27,11 @@ pub struct Effects {
     pub joints: bool,
     /// At least one SPRING, BUSHING or RSPRING (springs and dampers).
     pub springs: bool,
+    /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
+    /// prescribed in time, whose work enters the energy balance.
+    pub drivers: bool,
+    /// At least one revolute joint with clearance (CLEARANCE).
+    pub clearances: bool,
 }
 
 impl Effects {
@@ -44,6 +49,8 @@ impl Effects {
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
             (self.springs, "springs and dampers"),
+            (self.drivers, "drivers"),
+            (self.clearances, "clearance joints"),
         ];
         for (on, name) in list {
             if on {
@@ -96,6 +103,7 @@ impl Model {
         let mut e = Effects {
             gravity: self.gravity.is_some(),
             applied_loads: !self.loads.is_empty(),
+            drivers: !self.drives.is_empty(),
             ..Effects::default()
         };
         for el in self.elements.values() {
@@ -113,13 +121,18 @@ impl Model {
                         e.rigid_bodies = true;
                     } else {
                         e.flexible_beams = true;
+                        let mat = material.and_then(|m| self.materials.get(&m));
                         e.material_damping |= self
-                            .materials
-                            .get(material)
-                            .is_some_and(|m| m.damping > 0.0);
+                            .sections
+                            .get(section)
+                            .is_some_and(|s| s.damping(mat) > 0.0);
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
+                ElementKind::Clearance(c) => {
+                    e.clearances = true;
+                    e.friction |= c.friction > 0.0;
+                }
                 ElementKind::Hinge { .. }
                 | ElementKind::UJoint { .. }
                 | ElementKind::Spherical
@@ -130,6 +143,7 @@ impl Model {
                     e.springs = true;
                     e.friction |= r.friction > 0.0;
                 }
+                ElementKind::Prescribed { .. } => e.drivers = true,
             }
         }
         e
@@ -143,6 +157,7 @@ impl Model {
             *elements.entry(el.kind.keyword()).or_insert(0) += 1;
             constraints += el.kind.constraint_count(el.nodes.len());
         }
+        constraints += self.drives.len();
         let dofs = self
             .nodes
             .values()
