@@ -213,6 +213,22 @@ fn a_stop_at_a_pause_ends_at_that_step() {
     assert_eq!(rep.stats.steps, 30);
 }
 
+/// The spring family's histories (issue 25 §3): a SPRING's committed direction and an
+/// RSPRING's angle with its whole turns — the flywheel given a weak torsion spring
+/// (0.01 N·m/rad), so that a restart that lost the 2 turns made before it (θ ≈ 13 rad at
+/// half time) would apply another torque.
+#[test]
+fn springs_restart_bit_for_bit() {
+    check_restarts("spring_mass", &deck("spring_mass.dat"), &[0.4]);
+    let mut m = deck("flywheel.dat");
+    for el in m.elements.values_mut() {
+        if let mecano::model::ElementKind::RSpring(r) = &mut el.kind {
+            r.stiffness = 0.01;
+        }
+    }
+    check_restarts("flywheel", &m, &[0.5]);
+}
+
 #[test]
 fn drivers_restart_bit_for_bit() {
     // A driven hinge (its angle history), and a prescribed pivot across the law's end at

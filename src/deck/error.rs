@@ -71,7 +71,7 @@ pub enum DeckErrorKind {
     },
     /// An unknown element type.
     #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE"
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE, SPRING, BUSHING, RSPRING"
     )]
     UnknownElementType {
         /// The word.
@@ -394,6 +394,30 @@ pub enum DeckErrorKind {
         /// Line of the first definition.
         first_line: usize,
     },
+    /// A SPRING whose nodes coincide at t = 0.
+    #[error("SPRING element {element} joins nodes {first} and {second} at zero distance: {reason}")]
+    SpringZeroLength {
+        /// The spring.
+        element: u32,
+        /// Its first node.
+        first: u32,
+        /// Its second node.
+        second: u32,
+        /// Why that is refused.
+        reason: &'static str,
+    },
+    /// An RSPRING naming an element that is not a HINGE.
+    #[error(
+        "RSPRING element {element} names element {target}, a {found}: an RSPRING acts on a HINGE"
+    )]
+    NotAHinge {
+        /// The RSPRING.
+        element: u32,
+        /// The element it names.
+        target: u32,
+        /// That element's type keyword.
+        found: &'static str,
+    },
     /// A driver (a `DRIVE` on a joint, a `PRESCRIBED` element) that cannot be built.
     #[error("{context}: {reason}")]
     BadDrive {
@@ -480,6 +504,7 @@ impl DeckError {
             K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
                 "mecano::deck::element"
             }
+            K::SpringZeroLength { .. } | K::NotAHinge { .. } => "mecano::deck::spring",
             K::BadDrive { .. } => "mecano::deck::drive",
         }
     }

@@ -125,7 +125,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "K",
         "SECTIONS",
-        "shear correction factor (0 < k <= 1, default 5/6)",
+        "shear correction factor (0 < k <= 1, default 5/6); in ELEMENTS a stiffness (CAME, SPRING, BUSHING, RSPRING)",
     ),
     kw(
         "RIGID",
@@ -342,6 +342,56 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "IMPACT_STEPS",
         "ELEMENTS",
         "CAME: minimum steps per impact (>= 1, default 10)",
+    ),
+    kw(
+        "SPRING",
+        "ELEMENTS",
+        "two-node spring-damper along the line of its nodes (K, C, L0 or PRELOAD, CURVE)",
+    ),
+    kw(
+        "L0",
+        "ELEMENTS",
+        "SPRING: free length, m (>= 0; default: initial distance)",
+    ),
+    kw(
+        "PRELOAD",
+        "ELEMENTS",
+        "SPRING: tension at the initial distance, N (instead of L0)",
+    ),
+    kw(
+        "CURVE",
+        "ELEMENTS",
+        "SPRING: function number of a force-deflection curve F(deflection), N",
+    ),
+    kw(
+        "BUSHING",
+        "ELEMENTS",
+        "six-component linear bushing in a frame fixed to its first node",
+    ),
+    kw(
+        "AXES",
+        "ELEMENTS",
+        "BUSHING: axes e1 e2 of its frame, global at t = 0",
+    ),
+    kw(
+        "RSPRING",
+        "ELEMENTS",
+        "rotational spring, damper and friction on a HINGE element",
+    ),
+    kw(
+        "THETA0",
+        "ELEMENTS",
+        "RSPRING: unloaded angle, rad (default 0)",
+    ),
+    kw(
+        "FRICTION",
+        "ELEMENTS",
+        "RSPRING: Coulomb friction torque, N·m (>= 0)",
+    ),
+    kw(
+        "WREG",
+        "ELEMENTS",
+        "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
     ),
     kw(
         "CLEARANCE",

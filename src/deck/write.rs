@@ -6,7 +6,7 @@
 
 use crate::model::{
     Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
-    Scheme, Section, SectionData, Selection,
+    Scheme, Section, SectionData, Selection, SpringLength,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
@@ -201,7 +201,10 @@ pub fn write_deck(model: &Model) -> String {
                         .map(|n| n.0.to_string())
                         .collect()
                 }
-                None => e.nodes.iter().map(|n| n.0.to_string()).collect(),
+                None => match &e.kind {
+                    ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
+                    _ => e.nodes.iter().map(|n| n.0.to_string()).collect(),
+                },
             };
             let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
             match &e.kind {
@@ -270,6 +273,36 @@ pub fn write_deck(model: &Model) -> String {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
                 }
                 ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
+                ElementKind::Spring(p) => {
+                    let _ = write!(s, " K {:?} C {:?}", p.stiffness, p.damping);
+                    match p.length {
+                        SpringLength::Initial => {}
+                        SpringLength::Free(l) => {
+                            let _ = write!(s, " L0 {l:?}");
+                        }
+                        SpringLength::Preload(f) => {
+                            let _ = write!(s, " PRELOAD {f:?}");
+                        }
+                    }
+                    if let Some(f) = p.curve {
+                        let _ = write!(s, " CURVE {}", f.0);
+                    }
+                }
+                ElementKind::Bushing(b) => {
+                    let six = |v: &[f64; 6]| v.map(|x| format!("{x:?}")).join(" ");
+                    let _ = write!(s, " K {} C {}", six(&b.stiffness), six(&b.damping));
+                    if b.axes != Matrix3::identity() {
+                        let col = |i: usize| v3(&b.axes.column(i).into_owned());
+                        let _ = write!(s, " AXES {} {}", col(0), col(1));
+                    }
+                }
+                ElementKind::RSpring(r) => {
+                    let _ = write!(
+                        s,
+                        " K {:?} C {:?} THETA0 {:?} FRICTION {:?} WREG {:?}",
+                        r.stiffness, r.damping, r.angle0, r.friction, r.friction_speed
+                    );
+                }
                 ElementKind::Clearance(c) => {
                     let law = match c.law {
                         ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),

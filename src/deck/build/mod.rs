@@ -11,6 +11,7 @@ mod functions;
 mod nodes;
 mod properties;
 mod section;
+mod springs;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
@@ -58,6 +59,8 @@ struct Builder<'s> {
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
+    /// RSPRING elements' hinges (element, hinge number, its span), resolved after ELEMENTS.
+    hinge_refs: Vec<(ElementId, u32, Span)>,
     /// Driven joints (`DRIVE` on a HINGE or PRISMATIC card).
     drives: IndexMap<ElementId, crate::model::Drive>,
     /// The parameters in force (for the expressions of `t` of EXPR functions).
@@ -150,6 +153,7 @@ pub(crate) fn build_model(
         modes: None,
         output: None,
         divide: Vec::new(),
+        hinge_refs: Vec::new(),
         drives: IndexMap::new(),
         parameters,
     };
@@ -184,6 +188,7 @@ pub(crate) fn build_model(
         let r = b.element(c);
         b.push(r);
     }
+    b.resolve_hinges();
     for c in of(Section::Loads) {
         let r = b.load(c);
         b.push(r);
