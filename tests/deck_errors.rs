@@ -322,6 +322,24 @@ fn malformed_decks_table() {
             "ALPHA (HHT) = 0.1",
         ),
         (
+            "ANALYSIS DYNAMIC GENALPHA RHOINF 1.5 STEP 1e-3 END 1\n".into(),
+            1,
+            34,
+            "0 <= rho_inf <= 1",
+        ),
+        (
+            "ANALYSIS DYNAMIC ALPHA -0.1 GENALPHA STEP 1e-3 END 1\n".into(),
+            1,
+            29,
+            "ALPHA and GENALPHA cannot both be given",
+        ),
+        (
+            "ANALYSIS DYNAMIC RHOINF 0.5 STEP 1e-3 END 1\n".into(),
+            1,
+            44,
+            "GENALPHA",
+        ),
+        (
             "ANALYSIS DYNAMIC STEP 0 END 1\n".into(),
             1,
             23,

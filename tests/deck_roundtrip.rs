@@ -5,10 +5,13 @@ use mecano::deck::{load_deck, parse_deck, strip_spans, write_deck};
 use mecano::model::{ElementKind, Model};
 use std::path::PathBuf;
 
+/// The decks of `decks/` and of `decks/benchmarks/`.
 fn decks() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("decks");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("decks/ exists")
+    let mut v: Vec<PathBuf> = [dir.clone(), dir.join("benchmarks")]
+        .iter()
+        .filter_map(|d| std::fs::read_dir(d).ok())
+        .flatten()
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "dat"))
         .collect();
@@ -159,6 +162,8 @@ END
 this is not read",
         "NODES\n 1 0 0 0\nANALYSIS STATIC STEPS 4 TOL 1e-6\nOUTPUT ELEMENTS ALL NODES 1\n",
         "ANALYSIS DYNAMIC STEP 0.1 END 1\n",
+        "ANALYSIS DYNAMIC GENALPHA RHOINF 0.9 STEP 0.1 END 1 ADAPTIVE TOLPOS 1e-5 TOLROT 1e-4\n",
+        "ANALYSIS DYNAMIC STEP 0.1 END 1 GENALPHA\n",
     ];
     for deck in decks {
         let mut first = match parse_deck(deck, "rich.dat") {
@@ -175,6 +180,25 @@ this is not read",
         assert_eq!(first, second, "round trip differs\n{text}");
         assert_eq!(write_deck(&second), text);
     }
+    // GENALPHA reads to generalized-α (ρ∞ given, or the default), ALPHA alone to HHT.
+    let scheme = |d: &str| match parse_deck(d, "d").expect("valid").analysis {
+        mecano::model::Analysis::Dynamic { scheme, .. } => scheme,
+        other => panic!("{other:?}"),
+    };
+    use mecano::model::Scheme;
+    assert_eq!(scheme(decks[3]), Scheme::GeneralizedAlpha { rho_inf: 0.9 });
+    assert_eq!(
+        scheme(decks[4]),
+        Scheme::GeneralizedAlpha {
+            rho_inf: Scheme::DEFAULT_RHO_INF
+        }
+    );
+    assert_eq!(
+        scheme(decks[0]),
+        Scheme::Hht {
+            alpha: -0.3333333333
+        }
+    );
     let m = parse_deck(decks[0], "rich.dat").expect("valid");
     assert_eq!(m.title, "every   feature, with commas");
     assert_eq!(m.elements.len(), 7 + 12);

@@ -6,7 +6,7 @@ mod common;
 
 use common::deck;
 use mecano::elements::NodeState;
-use mecano::model::{Function, Model, NodeId};
+use mecano::model::{Function, Model, NodeId, Scheme};
 use mecano::output::History;
 use mecano::rotation;
 use mecano::solver;
@@ -33,7 +33,7 @@ fn idx(model: &Model, node: u32) -> usize {
 
 fn set_dynamic(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
     assert!(
-        model.set_fixed_step(h, t_end, alpha),
+        model.set_fixed_step(h, t_end, alpha.map(|alpha| Scheme::Hht { alpha })),
         "dynamic deck expected"
     );
 }

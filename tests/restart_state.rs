@@ -196,3 +196,26 @@ fn a_stop_at_a_pause_ends_at_that_step() {
     assert_eq!(rep.interrupted, Some(solver::Interruption::AtStep));
     assert_eq!(rep.stats.steps, 30);
 }
+
+#[test]
+fn drivers_restart_bit_for_bit() {
+    // A driven hinge (its angle history), and a prescribed pivot across the law's end at
+    // t = 1 s, where the accelerations restart (a third of the run).
+    check_restarts("driven_arm", &deck("driven_arm.dat"), &[0.25, 0.6]);
+    check_restarts(
+        "base_excited_pendulum",
+        &deck("base_excited_pendulum.dat"),
+        &[0.3, 0.3334, 0.5],
+    );
+}
+
+#[test]
+fn clearance_joint_restarts_bit_for_bit() {
+    // A journal bouncing and rolling in its bearing (touches, restarts of the
+    // accelerations, releases, the approach speed of each impact, friction).
+    check_restarts(
+        "clearance_orbit",
+        &deck("clearance_orbit.dat"),
+        &[0.2, 0.5, 0.8],
+    );
+}

@@ -164,8 +164,13 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
                 unreachable!()
             };
             assert_eq!(
-                (&m.materials[mat], &m.sections[sec], ax, ar),
-                (&m.materials[material], &m.sections[section], axis2, arc),
+                (mat.map(|x| &m.materials[&x]), &m.sections[sec], ax, ar),
+                (
+                    material.map(|x| &m.materials[&x]),
+                    &m.sections[section],
+                    axis2,
+                    arc
+                ),
                 "{}: beam {} differs from the rest of its bar",
                 m.title,
                 e.id
@@ -191,7 +196,7 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
                 }
             }
         }
-        let mut material = m.materials[material].clone();
+        let mut material = m.materials[&material.expect("the seed decks name materials")].clone();
         let mut section = m.sections[section].clone();
         (material.id, section.id) = (MaterialId(0), SectionId(0));
         bars.push(Bar {

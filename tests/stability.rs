@@ -6,14 +6,14 @@
 mod common;
 
 use common::deck;
-use mecano::model::{ElementId, ElementKind, Model, NodeId};
+use mecano::model::{ElementId, ElementKind, Model, NodeId, Scheme};
 use mecano::solver::{self, Observer, RunReport, Snapshot};
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::f64::consts::PI;
 
 fn set_steps(model: &mut Model, h: f64, t_end: f64, alpha: Option<f64>) {
     assert!(
-        model.set_fixed_step(h, t_end, alpha),
+        model.set_fixed_step(h, t_end, alpha.map(|alpha| Scheme::Hht { alpha })),
         "dynamic deck expected"
     );
 }
@@ -440,15 +440,10 @@ impl RacketBeam {
                 ElementKind::Beam {
                     material, section, ..
                 } => {
-                    let (m, s) = (&model.materials[material], &model.sections[section]);
+                    let (p, _) = model.beam_properties(*material, *section);
                     let n = [node(model, el.nodes[0].0), node(model, el.nodes[1].0)];
                     let le = (model.nodes[n[1]].position - model.nodes[n[0]].position).norm();
-                    let rho = m.density;
-                    beams.push((
-                        n,
-                        rho * s.area * le,
-                        Vector3::new(rho * (s.i2 + s.i3), rho * s.i2, rho * s.i3) * (0.5 * le),
-                    ));
+                    beams.push((n, p.mass * le, p.inertia * (0.5 * le)));
                 }
                 ElementKind::Mass { inertia, .. } => {
                     masses.push((node(model, el.nodes[0].0), *inertia));
@@ -699,4 +694,80 @@ fn fails_cleanly(name: &str) {
         files += 1;
     }
     assert!(files >= 3);
+}
+
+// ---------------------------------------------------------------- clearance joint
+
+/// A hard impact in a steel clearance joint (`decks/stab_clearance_impact.dat`: 1 kg at
+/// 5 m/s, Hertz K = 6.61e10, LN e = 0.9, rattling wall to wall for 2 ms) at base steps
+/// h = 1e-3 … 1e-6 s, the joint's events cutting the steps at each impact: every run
+/// completes; `E − W_ext` never rises above E(0) (+1e-6 of it: the impacts only
+/// dissipate); the deepest penetration (the first impact's) agrees with the impact ODE
+/// integrated by RK4 (`common::impact`) within `(π/N)²/4`, N = 10 steps per impact (the
+/// resolution's error, tests/clearance.rs) — from the coarsest base step to the finest.
+/// The unresolvable case is `clearance_impact_that_cannot_be_cut_fails_cleanly`.
+#[test]
+fn clearance_joint_hard_impact_over_the_step_range() {
+    let mut pens = Vec::new();
+    for h in [1e-3, 1e-4, 1e-5, 1e-6] {
+        let mut model = deck("stab_clearance_impact.dat");
+        set_steps(&mut model, h, 2e-3, None);
+        let mut integ = solver::prepare(&model).expect("prepare");
+        let mut rec = Rec::default();
+        let rep = solver::run_prepared(&model, &mut integ, &mut rec).expect("run starts");
+        assert!(rep.failure.is_none(), "h = {h}: {:?}", rep.failure);
+        let s = integ.sys.elements[0].summary().expect("summary");
+        let pen = s["max_penetration"].as_f64().unwrap();
+        let e0 = rec.e[0];
+        println!(
+            "clearance impact, h = {h:e}: {} steps ({} refused, smallest {:.2e} s), {:.2} it/step, {} impacts, penetration {pen:.4e} m, rise {:.2e} J of E0 {e0} J",
+            rep.stats.steps,
+            rep.stats.rejected_steps,
+            rep.stats.min_step,
+            it_per_step(&rep),
+            s["impacts"],
+            rise(&rec)
+        );
+        assert!(rise(&rec) <= 1e-6 * e0, "energy created");
+        assert_eq!(s["unresolved_steps"], 0, "every impact resolved");
+        pens.push(pen);
+    }
+    // The same impact with steps that may not be cut (MINSTEP = STEP = 1e-4 s, 3 steps per
+    // crossing of the clearance and none per impact): the run goes through, but it is not
+    // silently wrong: the joint counts the steps it had to accept unresolved.
+    let mut model = deck("stab_clearance_impact.dat");
+    set_steps(&mut model, 1e-4, 2e-3, None);
+    if let mecano::model::Analysis::Dynamic { min_step, .. } = &mut model.analysis {
+        *min_step = 1e-4;
+    }
+    let mut integ = solver::prepare(&model).expect("prepare");
+    let mut rec = Rec::default();
+    let rep = solver::run_prepared(&model, &mut integ, &mut rec).expect("run starts");
+    let s = integ.sys.elements[0].summary().expect("summary");
+    println!(
+        "clearance impact, h = MINSTEP = 1e-4: {:?}, {} unresolved steps, rise {:.2e} J",
+        rep.failure.as_ref().map(|f| f.to_string()),
+        s["unresolved_steps"],
+        rise(&rec)
+    );
+    assert!(s["unresolved_steps"].as_u64().unwrap() > 0);
+    let (m, v0, k) = (1.0, 5.0, 6.61e10f64);
+    let hertz = (5.0 * m * v0 * v0 / (4.0 * k)).powf(0.4);
+    let law = common::impact::lankarani_nikravesh(k, 1.5, 0.9, v0);
+    let (_, deepest) = common::impact::impact_ode(m, v0, law, 3.0 * hertz / v0, 20_000);
+    let tol = (PI / 10.0).powi(2) / 4.0;
+    for p in &pens {
+        println!(
+            "penetration {p:.5e} m, impact ODE {deepest:.5e} m, relative error {:.2e} (tol {tol:.2e})",
+            (p - deepest).abs() / deepest
+        );
+        assert!((p - deepest).abs() <= tol * deepest);
+    }
+}
+
+/// `decks/stab_clearance_nocut.dat`: a 50 m/s impact inside one step that may not be cut
+/// (MINSTEP = STEP, MAXIT 10): the run fails cleanly (`fails_cleanly`).
+#[test]
+fn clearance_impact_that_cannot_be_cut_fails_cleanly() {
+    fails_cleanly("stab_clearance_nocut");
 }

@@ -72,8 +72,8 @@ pub fn print_table(out: &mut dyn std::io::Write, a: &ModalAnalysis, step: Option
     if let Some(st) = step {
         let _ = writeln!(
             out,
-            "what the step resolves (HHT alpha {}, h = {:e} s): frequency Hz, samples per period, HHT damping ratio, period error",
-            st.alpha, st.h
+            "what the step resolves ({}, h = {:e} s): frequency Hz, samples per period, numerical damping ratio, period error",
+            st.scheme, st.h
         );
         let rows = output::step_resolution(a, st);
         for (i, r) in rows.iter().enumerate() {

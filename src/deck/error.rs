@@ -71,7 +71,7 @@ pub enum DeckErrorKind {
     },
     /// An unknown element type.
     #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME"
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE"
     )]
     UnknownElementType {
         /// The word.
@@ -196,6 +196,18 @@ pub enum DeckErrorKind {
         element: u32,
         /// What is wrong with the three points.
         reason: String,
+    },
+    /// A BEAM that names a material for a section given by its properties per unit length.
+    #[error(
+        "BEAM element {element} names material {material}, but section {section} gives its stiffness and inertia per unit length (PROPERTIES): remove MAT (a damping coefficient goes on the section card: DAMPING)"
+    )]
+    MaterialNotUsed {
+        /// Element number.
+        element: u32,
+        /// The material named.
+        material: u32,
+        /// The section of properties.
+        section: u32,
     },
     /// A zero or non-finite direction vector.
     #[error("{what} must be a non-zero finite vector, found ({x}, {y}, {z})")]
@@ -382,6 +394,14 @@ pub enum DeckErrorKind {
         /// Line of the first definition.
         first_line: usize,
     },
+    /// A driver (a `DRIVE` on a joint, a `PRESCRIBED` element) that cannot be built.
+    #[error("{context}: {reason}")]
+    BadDrive {
+        /// The card (`element 3 (UJOINT)`).
+        context: String,
+        /// What is wrong and what is accepted.
+        reason: String,
+    },
     /// `--set name=value` (or a sweep plan) for a parameter the deck does not define.
     #[error("cannot set parameter `{name}`: the deck does not define it ({known})")]
     UnknownOverride {
@@ -433,9 +453,10 @@ impl DeckError {
             K::Duplicate { .. } => "mecano::deck::duplicate",
             K::Undefined { .. } => "mecano::deck::undefined",
             K::BadGeneration { .. } => "mecano::deck::generation",
-            K::BeamSameNode { .. } | K::BeamZeroLength { .. } | K::BadArc { .. } => {
-                "mecano::deck::beam"
-            }
+            K::BeamSameNode { .. }
+            | K::BeamZeroLength { .. }
+            | K::BadArc { .. }
+            | K::MaterialNotUsed { .. } => "mecano::deck::beam",
             K::BadAxis { .. }
             | K::Axis2Parallel { .. }
             | K::PlaneParallel
@@ -459,6 +480,7 @@ impl DeckError {
             K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
                 "mecano::deck::element"
             }
+            K::BadDrive { .. } => "mecano::deck::drive",
         }
     }
 

@@ -107,7 +107,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "DAMPING",
         "MATERIALS",
-        "stiffness-proportional damping coefficient, s (>= 0, default 0)",
+        "stiffness-proportional damping coefficient, s (>= 0, default 0; also on a PROPERTIES section)",
     ),
     // sections
     kw("A", "SECTIONS", "area, m² (> 0)"),
@@ -131,6 +131,57 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "RIGID",
         "SECTIONS",
         "rigid bar section (also an element type in ELEMENTS)",
+    ),
+    kw(
+        "PROPERTIES",
+        "SECTIONS",
+        "the section is given by its stiffness and inertia per unit length (no material)",
+    ),
+    kw("EA", "SECTIONS", "PROPERTIES: axial stiffness EA, N (> 0)"),
+    kw(
+        "GA2",
+        "SECTIONS",
+        "PROPERTIES: shear stiffness along local axis 2, N (> 0)",
+    ),
+    kw(
+        "GA3",
+        "SECTIONS",
+        "PROPERTIES: shear stiffness along local axis 3, N (> 0)",
+    ),
+    kw(
+        "GJ",
+        "SECTIONS",
+        "PROPERTIES: torsional stiffness, N·m² (> 0)",
+    ),
+    kw(
+        "EI2",
+        "SECTIONS",
+        "PROPERTIES: bending stiffness about local axis 2, N·m² (> 0)",
+    ),
+    kw(
+        "EI3",
+        "SECTIONS",
+        "PROPERTIES: bending stiffness about local axis 3, N·m² (> 0)",
+    ),
+    kw(
+        "RHOA",
+        "SECTIONS",
+        "PROPERTIES: mass per unit length, kg/m (>= 0)",
+    ),
+    kw(
+        "RHOJ",
+        "SECTIONS",
+        "PROPERTIES: polar rotary inertia per unit length, kg·m (>= 0)",
+    ),
+    kw(
+        "RHOI2",
+        "SECTIONS",
+        "PROPERTIES: rotary inertia about local axis 2 per unit length, kg·m (>= 0)",
+    ),
+    kw(
+        "RHOI3",
+        "SECTIONS",
+        "PROPERTIES: rotary inertia about local axis 3 per unit length, kg·m (>= 0)",
     ),
     // nodes
     kw(
@@ -163,7 +214,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ELEMENTS",
         "geometrically exact beam (two nodes, or p + 1 with ORDER)",
     ),
-    kw("MAT", "ELEMENTS", "material number of a BEAM"),
+    kw(
+        "MAT",
+        "ELEMENTS",
+        "material number of a BEAM (none for a section of PROPERTIES)",
+    ),
     kw("SEC", "ELEMENTS", "section number of a BEAM"),
     kw(
         "DIVIDE",
@@ -203,6 +258,26 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw("SPHERICAL", "ELEMENTS", "spherical joint"),
     kw("CLAMP", "ELEMENTS", "two nodes welded together"),
     kw("PRISMATIC", "ELEMENTS", "prismatic (sliding) joint"),
+    kw(
+        "DRIVE",
+        "ELEMENTS",
+        "HINGE or PRISMATIC: the angle or travel prescribed as a·f(t) (function number)",
+    ),
+    kw(
+        "AMPLITUDE",
+        "ELEMENTS",
+        "DRIVE or PRESCRIBED: the factor a of a·f(t), rad or m (default 1)",
+    ),
+    kw(
+        "PRESCRIBED",
+        "ELEMENTS",
+        "a node's displacement component (X, Y, Z) or rotation about a fixed axis prescribed as a·f(t)",
+    ),
+    kw(
+        "ROTATION",
+        "ELEMENTS",
+        "PRESCRIBED: the node's rotation about a fixed global axis",
+    ),
     kw("CAME", "ELEMENTS", "cam-follower contact element"),
     kw("CAM", "ELEMENTS", "CAME: the cam's profile (first node)"),
     kw(
@@ -268,6 +343,33 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ELEMENTS",
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
+    kw(
+        "CLEARANCE",
+        "ELEMENTS",
+        "revolute joint with radial clearance (element type; and its clearance, m)",
+    ),
+    kw("RADIUS", "ELEMENTS", "CLEARANCE: bearing radius, m"),
+    kw(
+        "LAW",
+        "ELEMENTS",
+        "CLEARANCE: the normal force law (KV or LN)",
+    ),
+    kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
+    kw(
+        "LN",
+        "ELEMENTS",
+        "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
+    ),
+    kw(
+        "EXPONENT",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
+    ),
+    kw(
+        "VMIN",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
+    ),
     // functions
     kw(
         "TABLE",
@@ -323,7 +425,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "time function scaling a FORCE or MOMENT",
     ),
     // analysis
-    kw("DYNAMIC", "ANALYSIS", "implicit dynamics with HHT"),
+    kw(
+        "DYNAMIC",
+        "ANALYSIS",
+        "implicit dynamics (HHT-alpha, or generalized-alpha with GENALPHA)",
+    ),
     kw("STATIC", "ANALYSIS", "static equilibrium with load steps"),
     kw(
         "MODES",
@@ -334,6 +440,16 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ALPHA",
         "ANALYSIS",
         "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",
+    ),
+    kw(
+        "GENALPHA",
+        "ANALYSIS",
+        "generalized-alpha time integration instead of HHT",
+    ),
+    kw(
+        "RHOINF",
+        "ANALYSIS",
+        "generalized-alpha: spectral radius at infinity (0 <= rho <= 1, default 0.8)",
     ),
     kw("STEP", "ANALYSIS", "time step, s (> 0)"),
     kw(
@@ -557,4 +673,10 @@ pub fn strip_spans(model: &mut Model) {
     model.elements.values_mut().for_each(|x| x.span = zero);
     model.loads.iter_mut().for_each(|x| x.span = zero);
     model.initial.iter_mut().for_each(|x| x.span = zero);
+    model.drives.values_mut().for_each(|x| x.span = zero);
+    for e in model.elements.values_mut() {
+        if let crate::model::ElementKind::Prescribed { drive, .. } = &mut e.kind {
+            drive.span = zero;
+        }
+    }
 }

@@ -5,7 +5,8 @@
 //! written explicitly.
 
 use crate::model::{
-    Analysis, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile, Selection,
+    Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
+    Scheme, Section, SectionData, Selection,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
@@ -121,19 +122,7 @@ pub fn write_deck(model: &Model) -> String {
     if !model.sections.is_empty() {
         s.push_str("SECTIONS\n");
         for x in model.sections.values() {
-            if x.rigid {
-                let _ = writeln!(
-                    s,
-                    "  {} RIGID A {:?} I2 {:?} I3 {:?} J {:?}",
-                    x.id.0, x.area, x.i2, x.i3, x.torsion
-                );
-            } else {
-                let _ = writeln!(
-                    s,
-                    "  {} A {:?} I2 {:?} I3 {:?} J {:?} K {:?}",
-                    x.id.0, x.area, x.i2, x.i3, x.torsion, x.shear_factor
-                );
-            }
+            write_section(&mut s, x);
         }
     }
     if !model.nodes.is_empty() {
@@ -223,7 +212,10 @@ pub fn write_deck(model: &Model) -> String {
                     order,
                     arc,
                 } => {
-                    let _ = write!(s, " MAT {} SEC {}", material.0, section.0);
+                    if let Some(m) = material {
+                        let _ = write!(s, " MAT {}", m.0);
+                    }
+                    let _ = write!(s, " SEC {}", section.0);
                     if let Some(a) = axis2 {
                         let _ = write!(s, " AXIS2 {}", v3(a));
                     }
@@ -255,11 +247,50 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 ElementKind::Hinge { axis } | ElementKind::Prismatic { axis } => {
                     let _ = write!(s, " AXIS {}", v3(axis));
+                    if let Some(d) = model.drives.get(&e.id) {
+                        let _ = write!(s, " DRIVE {} AMPLITUDE {:?}", d.function.0, d.amplitude);
+                    }
+                }
+                ElementKind::Prescribed { motion, drive } => {
+                    match motion {
+                        crate::model::NodeMotion::Displacement(i) => {
+                            let _ = write!(s, " {}", ["X", "Y", "Z"][*i]);
+                        }
+                        crate::model::NodeMotion::Rotation(a) => {
+                            let _ = write!(s, " ROTATION AXIS {}", v3(a));
+                        }
+                    }
+                    let _ = write!(
+                        s,
+                        " FUNCTION {} AMPLITUDE {:?}",
+                        drive.function.0, drive.amplitude
+                    );
                 }
                 ElementKind::UJoint { axis1, axis2 } => {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
                 }
                 ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
+                ElementKind::Clearance(c) => {
+                    let law = match c.law {
+                        ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
+                        ContactLaw::LankaraniNikravesh {
+                            k,
+                            exponent,
+                            restitution,
+                        } => format!("LN {k:?} {restitution:?} EXPONENT {exponent:?}"),
+                    };
+                    let _ = write!(
+                        s,
+                        " AXIS {} RADIUS {:?} CLEARANCE {:?} LAW {law} MU {:?} VREG {:?} VMIN {:?} IMPACT_STEPS {}",
+                        v3(&c.axis),
+                        c.radius,
+                        c.clearance,
+                        c.friction,
+                        c.friction_speed,
+                        c.min_approach,
+                        c.impact_steps
+                    );
+                }
                 ElementKind::Came(c) => {
                     let _ = write!(
                         s,
@@ -316,7 +347,7 @@ pub fn write_deck(model: &Model) -> String {
         }
         (
             Analysis::Dynamic {
-                alpha,
+                scheme,
                 step,
                 end,
                 min_step,
@@ -326,9 +357,15 @@ pub fn write_deck(model: &Model) -> String {
             },
             None,
         ) => {
+            let _ = match scheme {
+                Scheme::Hht { alpha } => write!(s, "ANALYSIS DYNAMIC ALPHA {alpha:?}"),
+                Scheme::GeneralizedAlpha { rho_inf } => {
+                    write!(s, "ANALYSIS DYNAMIC GENALPHA RHOINF {rho_inf:?}")
+                }
+            };
             let _ = write!(
                 s,
-                "ANALYSIS DYNAMIC ALPHA {alpha:?} STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
+                " STEP {step:?} END {end:?} &\n  MINSTEP {min_step:?} MAXSTEP {max_step:?}"
             );
             if let Some(a) = adaptive {
                 let _ = write!(
@@ -382,4 +419,40 @@ pub fn write_deck(model: &Model) -> String {
 
 fn newton_kind(n: &crate::model::NewtonSettings) -> &'static str {
     if n.modified { "MODIFIED" } else { "FULL" }
+}
+
+/// One `SECTIONS` card: the geometry (`A I2 I3 J K`) or the properties per unit length
+/// (`PROPERTIES EA … RHOI3 [DAMPING η]`; a rigid one lists only its inertia).
+fn write_section(s: &mut String, x: &Section) {
+    let _ = write!(s, "  {}", x.id.0);
+    if x.rigid {
+        s.push_str(" RIGID");
+    }
+    match &x.data {
+        SectionData::Geometry(g) => {
+            let _ = write!(
+                s,
+                " A {:?} I2 {:?} I3 {:?} J {:?}",
+                g.area, g.i2, g.i3, g.torsion
+            );
+            if !x.rigid {
+                let _ = write!(s, " K {:?}", g.shear_factor);
+            }
+        }
+        SectionData::Properties { props: p, damping } => {
+            s.push_str(" PROPERTIES");
+            if !x.rigid {
+                let (n, m) = (p.cn, p.cm);
+                let _ = write!(s, " EA {:?} GA2 {:?} GA3 {:?}", n.x, n.y, n.z);
+                let _ = write!(s, " GJ {:?} EI2 {:?} EI3 {:?}", m.x, m.y, m.z);
+            }
+            let i = p.inertia;
+            let _ = write!(s, " RHOA {:?} RHOJ {:?}", p.mass, i.x);
+            let _ = write!(s, " RHOI2 {:?} RHOI3 {:?}", i.y, i.z);
+            if *damping != 0.0 {
+                let _ = write!(s, " DAMPING {damping:?}");
+            }
+        }
+    }
+    s.push('\n');
 }

@@ -26,7 +26,7 @@
 //! gyroscopic force `J Ω̇ + Ω × J Ω`. Gravity: `ρAL g / 2` on each node.
 //!
 //! # Damping
-//! A beam whose material has `DAMPING η` is built as the order-1 [`super::beam_p::BeamP`]
+//! A beam whose material (or section of properties) has `DAMPING η` is built as the order-1 [`super::beam_p::BeamP`]
 //! (the same element, tested equal), which carries the Kelvin–Voigt damping stresses
 //! `η C (Γ̇, K̇)` (`beam_p/damping.rs`); this element is the undamped fast path.
 
@@ -36,18 +36,9 @@ use crate::model::ElementId;
 use crate::rotation::{self, c, skew};
 use nalgebra::{Matrix3, Vector3};
 
-/// Section and material properties of a beam, per unit length.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BeamProperties {
-    /// `(EA, kGA, kGA)`, N.
-    pub cn: Vector3<f64>,
-    /// `(GJ, EI₂, EI₃)`, N·m².
-    pub cm: Vector3<f64>,
-    /// Mass per unit length `ρA`, kg/m.
-    pub mass: f64,
-    /// Rotary inertia per unit length `ρ(I₂+I₃, I₂, I₃)`, kg·m.
-    pub inertia: Vector3<f64>,
-}
+/// Section and material properties of a beam, per unit length (resolved in the model
+/// from a material and a geometry, or given by a section of properties).
+pub use crate::model::BeamProperties;
 
 /// A two-node geometrically exact beam.
 #[derive(Debug, Clone)]

@@ -236,20 +236,24 @@ impl BeamP {
         let mpts: Vec<Point> = ms.iter().zip(&mw).map(|(x, w)| point(*x, *w)).collect();
         let mut mass = vec![0.0; n * n];
         let mut lumped = vec![0.0; n];
+        let mut shares = vec![0.0; n];
         let mut length = 0.0;
         for q in &mpts {
             length += q.wj;
             for i in 0..n {
                 lumped[i] += q.wj * props.mass * q.n[i];
+                shares[i] += q.wj * q.n[i];
                 for j in 0..n {
                     mass[i * n + j] += q.wj * props.mass * q.n[i] * q.n[j];
                 }
             }
         }
-        // ∫ Nᵢ ds by the mass rule (exact for a straight element: degree p).
+        // ∫ Nᵢ ds by the mass rule (exact for a straight element: degree p); through the
+        // lumped mass when there is one (its round-off kept), else directly.
         let j_node = (0..n)
             .map(|i| {
-                let w = lumped[i] / props.mass.max(f64::MIN_POSITIVE);
+                let m = props.mass;
+                let w = if m > 0.0 { lumped[i] / m } else { shares[i] };
                 triads[i] * Matrix3::from_diagonal(&(props.inertia * w)) * triads[i].transpose()
             })
             .collect();
@@ -585,7 +589,7 @@ mod damping;
 mod residual;
 mod tangent;
 
-pub use build::{from_model, properties, with_properties};
+pub use build::{from_model, with_properties};
 
 #[cfg(test)]
 #[path = "beam_p_tests.rs"]

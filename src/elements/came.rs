@@ -59,7 +59,7 @@ use super::profile::Curve;
 use crate::model::{CameData, ElementId, Profile};
 use nalgebra::{Matrix3, Vector3};
 use num_dual::DualSVec64;
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64};
+use std::sync::atomic::AtomicU64;
 
 /// Changes of the active flag tolerated within one step attempt before it is frozen.
 pub const MAX_FLIPS: u32 = 4;
@@ -141,9 +141,7 @@ pub struct Came {
     /// ω estimated at the last trial state (bits of an f64).
     omega_trial: AtomicU64,
     // Per-attempt active-set memory (interior mutability: `evaluate` takes `&self`).
-    attempt: AtomicU64,
-    flips: AtomicU32,
-    last_flag: AtomicBool,
+    memory: law::ActiveSetMemory,
 }
 
 /// The history of a [`Came`] (committed contact state, counters, and the attempt memory
@@ -221,16 +219,14 @@ impl Came {
             last_power: 0.0,
             omega: 0.0,
             omega_trial: AtomicU64::new(0),
-            attempt: AtomicU64::new(u64::MAX),
-            flips: AtomicU32::new(0),
-            last_flag: AtomicBool::new(false),
+            memory: law::ActiveSetMemory::new(),
         })
     }
 }
 
 mod element;
-mod events;
+pub(crate) mod events;
 mod geometry;
-mod law;
+pub(crate) mod law;
 #[cfg(test)]
 mod tests;

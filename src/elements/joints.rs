@@ -162,6 +162,9 @@ pub struct Joint {
     nodes: Vec<usize>,
     pairs: Vec<Pair>,
     hist: History,
+    /// The driver of a driven HINGE or PRISMATIC (`DRIVE`): a sixth equation `Φ₆ =
+    /// θ − a f(t)` or `σ − a f(t)` (joints/drive.rs).
+    drive: Option<super::drive::TimeLaw>,
 }
 
 /// An orthonormal pair `(p, q)` with `(p, q, a)` right-handed.
@@ -255,6 +258,7 @@ impl Joint {
             nodes,
             pairs,
             hist: History::default(),
+            drive: None,
         })
     }
 
@@ -310,7 +314,11 @@ impl Joint {
             ElementKind::Rigid => JointType::Rigid,
             other => return Err(invalid(&format!("{} is not a joint", other.keyword()))),
         };
-        Joint::new(el.id, kind, idx, &x0)
+        let mut joint = Joint::new(el.id, kind, idx, &x0)?;
+        if let Some(d) = model.drives.get(&el.id) {
+            joint = joint.with_drive(super::drive::TimeLaw::from_model(model, d))?;
+        }
+        Ok(joint)
     }
 
     /// The joint type.
@@ -319,11 +327,12 @@ impl Joint {
     }
 
     fn m_pair(&self) -> usize {
-        self.kind.equations()
+        self.kind.equations() + usize::from(self.drive.is_some())
     }
 }
 
 mod constraints;
+mod drive;
 mod element;
 mod outputs;
 #[cfg(test)]

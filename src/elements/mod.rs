@@ -18,8 +18,11 @@
 pub mod beam;
 pub mod beam_p;
 pub mod came;
+pub mod clearance;
+pub mod drive;
 pub mod joints;
 pub mod mass;
+pub mod prescribed;
 pub mod profile;
 pub mod rigid_bar;
 
@@ -97,6 +100,26 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     }
                 }
             }
+            ElementKind::Prescribed { motion, drive } => {
+                let i = idx(&el.nodes[0]);
+                out.push(Box::new(prescribed::Prescribed::new(
+                    el.id,
+                    i,
+                    model.nodes[i].position,
+                    *motion,
+                    drive::TimeLaw::from_model(model, drive),
+                )));
+            }
+            ElementKind::Clearance(data) => {
+                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
+                let c = clearance::Clearance::new(el.id, nodes, data).map_err(|message| {
+                    BuildError::Invalid {
+                        element: el.id,
+                        message,
+                    }
+                })?;
+                out.push(Box::new(c));
+            }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
@@ -119,6 +142,8 @@ pub enum ElementState {
     Came(came::CameState),
     /// A joint ([`joints::Joint`]).
     Joint(joints::JointState),
+    /// A revolute joint with clearance ([`clearance::Clearance`]).
+    Clearance(clearance::ClearanceState),
 }
 
 /// A saved [`ElementState`] that does not belong to the element it is given to.
@@ -366,6 +391,27 @@ pub trait Element: Send + Sync {
     /// Element facts for `summary.json` (e.g. number of impacts of a contact).
     fn summary(&self) -> Option<serde_json::Value> {
         None
+    }
+
+    /// Time derivatives `[∂Φ_k/∂t, ∂²Φ_k/∂t²]` of the element's `k`-th constraint
+    /// (unscaled) at time `t`: zero for a scleronomic joint (the default), `[−a ḟ, −a f̈]`
+    /// for a driver's `g(q) − a f(t)` ([`drive::TimeLaw`]). The integrator's start imposes
+    /// `B v + Φ_t = 0` and `B v̇ + Ḃ v + Φ_tt = 0` with them.
+    fn constraint_time_derivatives(&self, _t: f64, _k: usize) -> [f64; 2] {
+        [0.0; 2]
+    }
+
+    /// Whether a constraint of the element depends on time (a driver). Default: no.
+    fn rheonomic(&self) -> bool {
+        false
+    }
+
+    /// Power the element's drivers deliver to the system at the state, W: for a driver
+    /// row `Φ = g(q) − a f(t)` with multiplier `μ = sλ̂ + pΦ`, the constraint force `−Bᵀμ`
+    /// does `−μ B v = −μ a ḟ` (on the constraint); the energy balance integrates it as
+    /// external work. Default 0.
+    fn input_power(&self, _ctx: &EvalContext, _nodes: &[NodeState], _lambda: &[f64]) -> f64 {
+        0.0
     }
 
     /// Dissipated power of element damping (contact dashpot, material damping), W, at the

@@ -41,8 +41,7 @@ impl RigidBar {
         else {
             unreachable!("RigidBar::from_model is called on beams only")
         };
-        let (mat, sec) = (&model.materials[material], &model.sections[section]);
-        let mut props = beam_p::properties(mat, sec);
+        let (mut props, _) = model.beam_properties(*material, *section);
         props.cn = Vector3::zeros();
         props.cm = Vector3::zeros();
         let x0: Vec<Vector3<f64>> = nodes.iter().map(|&i| model.nodes[i].position).collect();

@@ -7,19 +7,27 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+mod clearance;
+mod drive;
 mod expr;
 mod function;
 mod ids;
 mod mesh;
 pub mod order;
 mod output;
+mod scheme;
+mod section;
 mod summary;
 
+pub use clearance::{ClearanceData, ContactLaw};
+pub use drive::{Drive, NodeMotion};
 pub use expr::{BinOp, Expr, Func, TimeExpr};
 pub use function::{CubicSpline, Function, SplineError};
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};
+pub use scheme::{Scheme, SchemeNameError};
+pub use section::{BeamProperties, Geometry, Section, SectionData};
 pub use summary::{Effects, Generated, Summary};
 
 use indexmap::IndexMap;
@@ -71,27 +79,6 @@ pub struct Material {
     /// Stiffness-proportional (Rayleigh) damping coefficient, s (≥ 0; 0 = none).
     pub damping: f64,
     /// Where the material was defined.
-    pub span: Span,
-}
-
-/// A beam cross-section.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Section {
-    /// The user's number.
-    pub id: SectionId,
-    /// Area A, m².
-    pub area: f64,
-    /// Second moment about local axis 2, I2, m⁴.
-    pub i2: f64,
-    /// Second moment about local axis 3, I3, m⁴.
-    pub i3: f64,
-    /// Torsion constant J, m⁴.
-    pub torsion: f64,
-    /// Shear correction factor k (default 5/6).
-    pub shear_factor: f64,
-    /// A rigid section: the bar keeps its shape (its mass still comes from ρA).
-    pub rigid: bool,
-    /// Where the section was defined.
     pub span: Span,
 }
 
@@ -169,8 +156,9 @@ pub enum ElementKind {
     /// Geometrically exact beam of order `order` (`order + 1` nodes along the axis: the
     /// two ends the user named and, for `order > 1`, generated interior nodes).
     Beam {
-        /// Material.
-        material: MaterialId,
+        /// Material: `Some` exactly when the section is given by its geometry
+        /// ([`Section::needs_material`]); a section of properties per unit length has none.
+        material: Option<MaterialId>,
         /// Section.
         section: SectionId,
         /// Direction of the section's local axis 2 in the reference configuration
@@ -214,6 +202,15 @@ pub enum ElementKind {
     Rigid,
     /// Cam–follower contact (first node: cam, second: follower).
     Came(Box<CameData>),
+    /// A prescribed motion of one node (`PRESCRIBED`, [`drive`](self::Drive)).
+    Prescribed {
+        /// What is prescribed.
+        motion: NodeMotion,
+        /// Its value `a f(t)`.
+        drive: Drive,
+    },
+    /// Revolute joint with radial clearance (first node: bearing, second: journal).
+    Clearance(Box<ClearanceData>),
 }
 
 impl ElementKind {
@@ -229,6 +226,8 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => "PRISMATIC",
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
+            ElementKind::Prescribed { .. } => "PRESCRIBED",
+            ElementKind::Clearance(_) => "CLEARANCE",
         }
     }
 
@@ -241,6 +240,7 @@ impl ElementKind {
             ElementKind::Clamp => 6,
             ElementKind::Prismatic { .. } => 5,
             ElementKind::Rigid => 6 * node_count.saturating_sub(1),
+            ElementKind::Prescribed { motion, .. } => motion.equations(),
             _ => 0,
         }
     }
@@ -327,10 +327,10 @@ pub struct Adaptive {
 /// The analysis to run.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Analysis {
-    /// Implicit dynamics with HHT.
+    /// Implicit dynamics.
     Dynamic {
-        /// HHT α ∈ [−1/3, 0].
-        alpha: f64,
+        /// The time integration scheme (HHT-α, generalized-α, …).
+        scheme: Scheme,
         /// Time step h (initial step when adaptive), s.
         step: f64,
         /// End time, s.
@@ -356,15 +356,15 @@ pub enum Analysis {
 
 impl Model {
     /// Switches a dynamic analysis to fixed steps `h` (minimum step `h/1024`) up to `end`,
-    /// with HHT `alpha` if given; returns `false` (and changes nothing) for a static one.
-    /// For studies and tests that rerun a deck at other steps.
-    pub fn set_fixed_step(&mut self, h: f64, end: f64, alpha: Option<f64>) -> bool {
+    /// with the time integration `scheme` if given; returns `false` (and changes nothing)
+    /// for a static one. For studies and tests that rerun a deck at other steps.
+    pub fn set_fixed_step(&mut self, h: f64, end: f64, scheme: Option<Scheme>) -> bool {
         let Analysis::Dynamic {
             step,
             end: e,
             min_step,
             max_step,
-            alpha: a,
+            scheme: a,
             adaptive,
             ..
         } = &mut self.analysis
@@ -376,7 +376,7 @@ impl Model {
         *min_step = h / 1024.0;
         *max_step = h;
         *adaptive = None;
-        if let Some(v) = alpha {
+        if let Some(v) = scheme {
             *a = v;
         }
         true
@@ -424,4 +424,7 @@ pub struct Model {
     /// The interior nodes generated for beams of order > 1 (`ORDER p`), by element, along
     /// the axis (see [`order`](self::order)).
     pub order_nodes: IndexMap<ElementId, Vec<NodeId>>,
+    /// Driven joints (`HINGE … DRIVE f`, `PRISMATIC … DRIVE f`), by the joint's number:
+    /// one more constraint each (model/drive.rs).
+    pub drives: IndexMap<ElementId, Drive>,
 }

@@ -25,6 +25,11 @@ pub struct Effects {
     pub rigid_bodies: bool,
     /// At least one kinematic joint.
     pub joints: bool,
+    /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
+    /// prescribed in time, whose work enters the energy balance.
+    pub drivers: bool,
+    /// At least one revolute joint with clearance (CLEARANCE).
+    pub clearances: bool,
 }
 
 impl Effects {
@@ -41,6 +46,8 @@ impl Effects {
             (self.flexible_beams, "flexible beams"),
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
+            (self.drivers, "drivers"),
+            (self.clearances, "clearance joints"),
         ];
         for (on, name) in list {
             if on {
@@ -93,6 +100,7 @@ impl Model {
         let mut e = Effects {
             gravity: self.gravity.is_some(),
             applied_loads: !self.loads.is_empty(),
+            drivers: !self.drives.is_empty(),
             ..Effects::default()
         };
         for el in self.elements.values() {
@@ -110,18 +118,24 @@ impl Model {
                         e.rigid_bodies = true;
                     } else {
                         e.flexible_beams = true;
+                        let mat = material.and_then(|m| self.materials.get(&m));
                         e.material_damping |= self
-                            .materials
-                            .get(material)
-                            .is_some_and(|m| m.damping > 0.0);
+                            .sections
+                            .get(section)
+                            .is_some_and(|s| s.damping(mat) > 0.0);
                     }
                 }
                 ElementKind::Rigid => e.rigid_bodies = true,
+                ElementKind::Clearance(c) => {
+                    e.clearances = true;
+                    e.friction |= c.friction > 0.0;
+                }
                 ElementKind::Hinge { .. }
                 | ElementKind::UJoint { .. }
                 | ElementKind::Spherical
                 | ElementKind::Clamp
                 | ElementKind::Prismatic { .. } => e.joints = true,
+                ElementKind::Prescribed { .. } => e.drivers = true,
             }
         }
         e
@@ -135,6 +149,7 @@ impl Model {
             *elements.entry(el.kind.keyword()).or_insert(0) += 1;
             constraints += el.kind.constraint_count(el.nodes.len());
         }
+        constraints += self.drives.len();
         let dofs = self
             .nodes
             .values()

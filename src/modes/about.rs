@@ -138,11 +138,11 @@ fn analyse_model_with(
     Ok((integ, a))
 }
 
-/// The deck's step and α when it is dynamic.
+/// The deck's step and integration scheme when it is dynamic.
 pub fn deck_step(model: &Model) -> Option<DeckStep> {
     match &model.analysis {
-        Analysis::Dynamic { alpha, step, .. } => Some(DeckStep {
-            alpha: *alpha,
+        Analysis::Dynamic { scheme, step, .. } => Some(DeckStep {
+            scheme: *scheme,
             h: *step,
         }),
         Analysis::Static { .. } => None,

@@ -1,21 +1,28 @@
-//! What a time step resolves: the spectral properties of HHT-α on the undamped
-//! oscillator `ẍ + ω²x = 0`, and the table of samples per period, numerical damping and
-//! period error for the modes of a model at a deck's step.
+//! What a time step resolves: the spectral properties of the time integration scheme
+//! (HHT-α, generalized-α) on the undamped oscillator `ẍ + ω²x = 0`, and the table of
+//! samples per period, numerical damping and period error for the modes of a model at a
+//! deck's step.
 //!
-//! In the linear case the project's Lie-group HHT (Arnold & Brüls 2007, `α_m = 0`,
-//! `α_f = −α`) is Hilber, Hughes & Taylor's (1977) scheme: with `X = x`, `V = h v`,
-//! `A = h² a` and `Ω = ω h`,
-//! `A₁ + Ω²[(1 − α_f) X₁ + α_f X₀] = 0`, `X₁ = X₀ + V₀ + (½ − β) A₀ + β A₁`,
-//! `V₁ = V₀ + (1 − γ) A₀ + γ A₁`, i.e. `L u₁ = R u₀` and the amplification matrix
-//! `𝐀 = L⁻¹R`. Its principal pair `λ = exp(Ω̄(−ξ̄ ± i))` gives the numerical damping
-//! ratio `ξ̄ = −ln|λ| / Ω̄` and the relative period error `T̄/T − 1 = Ω/Ω̄ − 1`
-//! (Hughes, *The Finite Element Method*, §9.3.2); the spectral radius at `Ω → ∞` is
-//! `ρ∞ = (1 + α)/(1 − α)`.
+//! In the linear case the project's Lie-group schemes of the α family (Arnold & Brüls
+//! 2007) are Chung & Hulbert's (1993) generalized-α, HHT being `α_m = 0`, `α_f = −α`: with
+//! `X = x`, `V = h v`, `A = h² a` (pseudo-acceleration), `Ā = h² v̇` and `Ω = ω h`,
+//! `Ā₁ = −Ω² X₁`, `(1 − α_m) A₁ + α_m A₀ = (1 − α_f) Ā₁ + α_f Ā₀`,
+//! `X₁ = X₀ + V₀ + (½ − β) A₀ + β A₁`, `V₁ = V₀ + (1 − γ) A₀ + γ A₁`; eliminating `Ā`:
+//! `(1 − α_m) A₁ + Ω²(1 − α_f) X₁ = −α_m A₀ − Ω² α_f X₀`, i.e. `L u₁ = R u₀` on
+//! `u = (X, V, A)` and the amplification matrix `𝐀 = L⁻¹R` (Chung & Hulbert 1993, eq. 15).
+//! Its principal pair `λ = exp(Ω̄(−ξ̄ ± i))` gives the numerical damping ratio
+//! `ξ̄ = −ln|λ| / Ω̄` and the relative period error `T̄/T − 1 = Ω/Ω̄ − 1` (Hughes, *The
+//! Finite Element Method*, §9.3.2); the spectral radius at `Ω → ∞` is the scheme's `ρ∞`
+//! (HHT: `(1 + α)/(1 − α)`).
+//!
+//! Another scheme plugs in with an arm in [`spectral`]: its own amplification matrix (any
+//! size) and principal root.
 
-use crate::solver::integrator::HhtParams;
+use crate::model::Scheme;
+use crate::solver::integrator::AlphaParams;
 use nalgebra::Matrix3;
 
-/// HHT's spectral properties at one `Ω = ωh`.
+/// A scheme's spectral properties at one `Ω = ωh`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Spectral {
     /// `Ω = ω h`.
@@ -29,30 +36,42 @@ pub struct Spectral {
     pub period_error: f64,
 }
 
-/// The amplification matrix of HHT-α for `Ω = ωh` (module docs).
-pub fn amplification(alpha: f64, omega_h: f64) -> Matrix3<f64> {
-    let p = HhtParams::new(alpha);
-    let (af, b, g) = (p.alpha_f, p.beta, p.gamma);
+/// The amplification matrix of the α family for `Ω = ωh` (module docs).
+pub fn amplification(p: &AlphaParams, omega_h: f64) -> Matrix3<f64> {
+    let (am, af, b, g) = (p.alpha_m, p.alpha_f, p.beta, p.gamma);
     let w2 = omega_h * omega_h;
     #[rustfmt::skip]
     let l = Matrix3::new(
         1.0, 0.0, -b,
         0.0, 1.0, -g,
-        w2 * (1.0 - af), 0.0, 1.0,
+        w2 * (1.0 - af), 0.0, 1.0 - am,
     );
     #[rustfmt::skip]
     let r = Matrix3::new(
         1.0, 1.0, 0.5 - b,
         0.0, 1.0, 1.0 - g,
-        -w2 * af, 0.0, 0.0,
+        -w2 * af, 0.0, -am,
     );
-    // det L = 1 + βΩ²(1 − α_f) > 0: always invertible.
-    l.try_inverse().expect("det L = 1 + βΩ²(1 − α_f) > 0") * r
+    // det L = (1 − α_m) + βΩ²(1 − α_f) > 0 (α_m ≤ ½, α_f < 1): always invertible.
+    l.try_inverse()
+        .expect("det L = (1 − α_m) + βΩ²(1 − α_f) > 0")
+        * r
 }
 
-/// HHT's numerical damping ratio and period error at `Ω = ωh` (module docs).
-pub fn spectral(alpha: f64, omega_h: f64) -> Spectral {
-    let ev = amplification(alpha, omega_h).complex_eigenvalues();
+/// The numerical damping ratio and period error of `scheme` at `Ω = ωh` (module docs).
+pub fn spectral(scheme: &Scheme, omega_h: f64) -> Spectral {
+    match scheme {
+        Scheme::Hht { .. } | Scheme::GeneralizedAlpha { .. } => {
+            principal_of(&amplification(&AlphaParams::of(scheme), omega_h), omega_h)
+        }
+    }
+}
+
+/// Spectral radius, damping and period error from an amplification matrix whose
+/// principal pair is its complex pair of largest modulus (the α family's spurious root is
+/// real).
+fn principal_of(a: &Matrix3<f64>, omega_h: f64) -> Spectral {
+    let ev = a.complex_eigenvalues();
     let radius = ev.iter().map(|z| z.norm()).fold(0.0, f64::max);
     // The principal root: the one of largest positive argument (the spurious root is real).
     let principal = ev
@@ -85,17 +104,18 @@ pub struct Resolution {
     pub frequency_hz: f64,
     /// Steps per period `1 / (f h)`.
     pub samples_per_period: f64,
-    /// HHT's numerical damping ratio at `ωh`.
+    /// The scheme's numerical damping ratio at `ωh` (the name dates from HHT alone; kept
+    /// for the files that carry it).
     pub hht_damping: f64,
-    /// HHT's relative period error at `ωh` (`None` when the step does not resolve the
+    /// The scheme's relative period error at `ωh` (`None` when the step does not resolve the
     /// mode: the principal pair is real, or `ωh > π`).
     pub period_error: Option<f64>,
 }
 
-/// The resolution of a mode of `frequency_hz` by HHT-α with step `h`.
-pub fn resolution(alpha: f64, h: f64, frequency_hz: f64) -> Resolution {
+/// The resolution of a mode of `frequency_hz` by `scheme` with step `h`.
+pub fn resolution(scheme: &Scheme, h: f64, frequency_hz: f64) -> Resolution {
     let omega_h = 2.0 * std::f64::consts::PI * frequency_hz * h;
-    let s = spectral(alpha, omega_h);
+    let s = spectral(scheme, omega_h);
     Resolution {
         frequency_hz,
         samples_per_period: 1.0 / (frequency_hz * h),
@@ -113,7 +133,7 @@ mod tests {
         // α = 0 is the trapezoidal rule: |λ| = 1 exactly and Ω̄ = 2 atan(Ω/2)
         // (λ = (1 − Ω²/4 ± iΩ)/(1 + Ω²/4)). Tolerances: a few ε of the 3×3 eigen-solve.
         for w in [1e-2, 0.1, 0.5, 1.0, 2.0, 10.0] {
-            let s = spectral(0.0, w);
+            let s = spectral(&Scheme::Hht { alpha: 0.0 }, w);
             let exact = w / (2.0 * (w / 2.0).atan()) - 1.0;
             assert!(s.damping.abs() < 1e-12, "Ω {w}: ξ {}", s.damping);
             assert!((s.radius - 1.0).abs() < 1e-12);
@@ -130,29 +150,30 @@ mod tests {
         // (α = −1/3 is left out: there the three roots meet as Ω → ∞ and the radius reaches
         // its limit only as a fractional power of 1/Ω.)
         for alpha in [-0.05, -0.1, -0.2, -0.3] {
+            let hht = Scheme::Hht { alpha };
             // ρ∞ = (1 + α)/(1 − α) (Hilber et al. 1977): at Ω = 1e6 the radius is within
             // O(1/Ω²) = 1e-12 of its limit; 1e-9 leaves room for the eigen-solve.
-            let rho = spectral(alpha, 1e6).radius;
+            let rho = spectral(&hht, 1e6).radius;
             let limit = (1.0 + alpha) / (1.0 - alpha);
             assert!((rho - limit).abs() < 1e-9, "α {alpha}: {rho} vs {limit}");
             // Small steps: HHT is second-order accurate with dissipation of third order
             // (Hilber et al. 1977): ξ̄ = c₁Ω³ + O(Ω⁵), T̄/T − 1 = c₂Ω² + O(Ω⁴), so halving Ω
             // divides ξ̄ by 8 and the period error by 4, to relative O(Ω²) = 1e-4 at
             // Ω = 1e-2 (tolerance 1e-3 for the round-off ε/Ω³ ≈ 2e-10 relative).
-            let (a1, a2) = (spectral(alpha, 2e-2), spectral(alpha, 1e-2));
+            let (a1, a2) = (spectral(&hht, 2e-2), spectral(&hht, 1e-2));
             let (rd, rp) = (a1.damping / a2.damping, a1.period_error / a2.period_error);
             assert!((rd - 8.0).abs() < 8e-3, "α {alpha}: damping ratio {rd}");
             assert!((rp - 4.0).abs() < 4e-3, "α {alpha}: period ratio {rp}");
             let s = a2;
             // The scheme damps more as Ω grows, and never amplifies.
-            assert!(spectral(alpha, 1.0).damping > s.damping);
-            assert!(spectral(alpha, 1.0).radius <= 1.0 + 1e-12);
+            assert!(spectral(&hht, 1.0).damping > s.damping);
+            assert!(spectral(&hht, 1.0).radius <= 1.0 + 1e-12);
         }
     }
 
     #[test]
     fn resolution_counts_samples_per_period() {
-        let r = resolution(-0.1, 1e-3, 10.0);
+        let r = resolution(&Scheme::default(), 1e-3, 10.0);
         assert!((r.samples_per_period - 100.0).abs() < 1e-9);
         assert!(r.hht_damping > 0.0 && r.period_error.is_some());
     }

@@ -9,27 +9,27 @@ use crate::solver::system::{FIXED, System};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The deck's time step and HHT α, when it is a dynamic deck: what
+/// The deck's time step and integration scheme, when it is a dynamic deck: what
 /// [`step_resolution`] judges the modes against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DeckStep {
-    /// HHT α.
-    pub alpha: f64,
+    /// The time integration scheme.
+    pub scheme: crate::model::Scheme,
     /// Time step, s.
     pub h: f64,
 }
 
 /// The step-resolution table: for each elastic mode of `analysis`, and for the mesh's
-/// highest frequency (last row), samples per period, HHT's damping and period error.
+/// highest frequency (last row), samples per period, the scheme's damping and period error.
 pub fn step_resolution(analysis: &ModalAnalysis, step: DeckStep) -> Vec<Resolution> {
     let mut rows: Vec<Resolution> = analysis
         .modes
         .iter()
         .filter(|m| m.natural_hz > 0.0 && m.kind == super::ModeKind::Elastic)
-        .map(|m| hht::resolution(step.alpha, step.h, m.natural_hz))
+        .map(|m| hht::resolution(&step.scheme, step.h, m.natural_hz))
         .collect();
     if analysis.highest_hz > 0.0 {
-        rows.push(hht::resolution(step.alpha, step.h, analysis.highest_hz));
+        rows.push(hht::resolution(&step.scheme, step.h, analysis.highest_hz));
     }
     rows
 }
@@ -134,7 +134,9 @@ pub fn summary(
         .collect();
     let resolution = step.map(|st| {
         serde_json::json!({
-            "alpha": st.alpha,
+            "integrator": st.scheme.name(),
+            "alpha": st.scheme.hht_alpha(),
+            "rho_inf": st.scheme.rho_inf(),
             "step": st.h,
             "modes": step_resolution(a, st),
             "note": "last row: the mesh's highest frequency; period_error null = not resolved",

@@ -46,7 +46,9 @@ pub fn block(model: &Model, unknowns: usize) -> Option<serde_json::Value> {
     Some(serde_json::json!({
         "computed": true,
         "about": "the initial state (mecano-rs modes)",
-        "alpha": step.alpha,
+        "integrator": step.scheme.name(),
+        "alpha": step.scheme.hht_alpha(),
+        "rho_inf": step.scheme.rho_inf(),
         "step": step.h,
         "free_unknowns": a.free_unknowns,
         "rigid_modes": a.rigid_modes,
@@ -58,7 +60,7 @@ pub fn block(model: &Model, unknowns: usize) -> Option<serde_json::Value> {
 
 /// The lines `mecano-rs study` prints beside its errors: for each step of its ladder, what
 /// it resolves of the lowest elastic mode and of the mesh's highest frequency about the
-/// initial state (at the deck's α), or why it is not computed (above
+/// initial state (with the deck's scheme), or why it is not computed (above
 /// [`RUN_MAX_UNKNOWNS`], as the run's block).
 pub fn study_lines(model: &Model, steps: &[f64], out: &mut dyn std::io::Write) {
     let Some(deck) = deck_step(model) else {
@@ -91,14 +93,14 @@ pub fn study_lines(model: &Model, steps: &[f64], out: &mut dyn std::io::Write) {
     }
     let _ = writeln!(
         out,
-        "what the steps resolve (modes about the initial state, HHT alpha {}; mecano-rs modes): samples per period, HHT damping ratio, period error",
-        deck.alpha
+        "what the steps resolve (modes about the initial state, {}; mecano-rs modes): samples per period, numerical damping ratio, period error",
+        deck.scheme
     );
     for &h in steps {
         let rows = step_resolution(
             &a,
             super::output::DeckStep {
-                alpha: deck.alpha,
+                scheme: deck.scheme,
                 h,
             },
         );

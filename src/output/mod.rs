@@ -11,6 +11,7 @@
 //! # The energy balance (`energy.csv`)
 //! `E = T + U + V_g` (kinetic, strain and contact-spring, gravity potential relative to
 //! the initial configuration). With `W_ext = ∫ P_ext dt` the work of the applied loads and
+//! of the drivers (`P = τ·a ḟ` of each prescribed motion, [`crate::elements::Element::input_power`]) and
 //! `D_c = ∫ P_damp dt` the energy dissipated by dampers (contact dashpots, trapezoidal
 //! rule over each step), the balance reads `E(t) − E(0) = W_ext − D_c − D_num`, where
 //! `D_num`, the remainder, is the energy removed by the integrator's numerical damping.

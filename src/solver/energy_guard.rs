@@ -4,7 +4,7 @@
 //!
 //! Over one step from state n to trial state n+1, with `E = T + U + V_g` (kinetic,
 //! strain and contact-spring, gravity potential) and the trapezoidal work of the applied
-//! loads `ΔW` and of the dampers `ΔD` (as `output::Writer` accounts them), the energy the
+//! loads and drivers `ΔW` and of the dampers `ΔD` (as `output::Writer` accounts them), the energy the
 //! step *created* is `C = (E_{n+1} − E_n) − (ΔW − ΔD)`. HHT with `α ≤ 0` is dissipative
 //! for linear systems and creates, on a resolved nonlinear step, a small fraction of the
 //! energy in play (O(ωh) of it). A step is refused when both
@@ -65,9 +65,23 @@ pub fn check(
     h: f64,
     floor: f64,
 ) -> Option<EnergyJump> {
+    check_driven(sys, old, new, t0, h, floor, 0.0)
+}
+
+/// [`check`] with the work the drivers did over the step (`driver_work`, J: their power
+/// needs the multipliers, which the nodes' states do not hold).
+pub fn check_driven(
+    sys: &System,
+    old: &[NodeState],
+    new: &[NodeState],
+    t0: f64,
+    h: f64,
+    floor: f64,
+    driver_work: f64,
+) -> Option<EnergyJump> {
     let (before, e_old) = energy_of(sys, old);
     let (after, e_new) = energy_of(sys, new);
-    let w = 0.5 * (sys.external_power(t0, old) + sys.external_power(t0 + h, new)) * h;
+    let w = 0.5 * (sys.external_power(t0, old) + sys.external_power(t0 + h, new)) * h + driver_work;
     let power = |nodes: &[NodeState]| -> f64 {
         sys.elements.iter().map(|e| e.dissipated_power(nodes)).sum()
     };

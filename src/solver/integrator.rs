@@ -1,17 +1,21 @@
-//! HHT time integration on the Lie group `(ℝ³ × SO(3))ⁿ`, Newton–Raphson, step cutting.
+//! HHT and generalized-α time integration on the Lie group `(ℝ³ × SO(3))ⁿ`, Newton–Raphson,
+//! step cutting.
 //!
-//! # The scheme (Arnold & Brüls 2007; Brüls, Cardona & Arnold 2012, with `α_m = 0`)
-//! With HHT's `α ∈ [−1/3, 0]`: `α_f = −α`, `β = (1−α)²/4`, `γ = ½ − α` (Hilber, Hughes &
-//! Taylor 1977). Per degree of freedom, with the pseudo-acceleration `a`:
+//! # The scheme (Arnold & Brüls 2007; Brüls, Cardona & Arnold 2012)
+//! The α family ([`AlphaParams`]): HHT's `α ∈ [−1/3, 0]` is `α_m = 0`, `α_f = −α`,
+//! `β = (1−α)²/4`, `γ = ½ − α` (Hilber, Hughes & Taylor 1977); generalized-α's `ρ∞ ∈ [0, 1]`
+//! is `α_m = (2ρ∞−1)/(ρ∞+1)`, `α_f = ρ∞/(ρ∞+1)`, `γ = ½ + α_f − α_m`, `β = ¼(γ+½)²`
+//! (Chung & Hulbert 1993). Per degree of freedom, with the pseudo-acceleration `a`:
 //! - `q_{n+1} = q_n ∘ exp(u)`, `u = h v_n + h²(½ − β) a_n + h² β a_{n+1}`;
 //! - `v_{n+1} = v_n + h(1 − γ) a_n + h γ a_{n+1}`;
-//! - `a_{n+1} = (1 − α_f) v̇_{n+1} + α_f v̇_n`;
+//! - `(1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) v̇_{n+1} + α_f v̇_n`;
 //! - equilibrium `r(q_{n+1}, v_{n+1}, v̇_{n+1}, λ_{n+1}) = 0`, `Φ(q_{n+1}) = 0` at `t_{n+1}`.
 //!
 //! For rotations `∘ exp` is `R_{n+1} = R_n exp(ũ)`, so orientations never pass through a
 //! parametrisation singularity. The unknown of Newton's method is `u` (and the scaled
-//! multipliers): `∂v/∂u = γ/(βh)`, `∂v̇/∂u = 1/((1−α_f)βh²)`, and the rotational columns of
-//! the stiffness carry the tangent map `T(u)` of the exponential (exact iteration matrix).
+//! multipliers): `∂v/∂u = γ/(βh)`, `∂v̇/∂u = (1−α_m)/((1−α_f)βh²)`, and the rotational
+//! columns of the stiffness carry the tangent map `T(u)` of the exponential (exact
+//! iteration matrix).
 //!
 //! Newton is *modified* (the matrix is kept, also from one step to the next of the same
 //! size, while each iteration divides the residual by at least 1/[`CONTRACTION`] = 4; then only
@@ -20,13 +24,13 @@
 //! stagnates, so the converged states equal full Newton's (1.5e-8 m on the rigid pendulum
 //! after 0.3 s, where h vs h/2 differ by 1.5e-7 m). On the pendulum this makes a step
 //! 5.4× cheaper (81 µs instead of 440 µs).
-//! The scheme is second-order accurate and, for linear problems, has HHT's spectral radius
-//! at infinity `ρ∞ = (1 + α)/(1 − α)`.
+//! The scheme is second-order accurate and, for linear problems, has the spectral radius
+//! at infinity `ρ∞` (HHT: `(1 + α)/(1 − α)`).
 
 use super::system::System;
 use super::{Failure, FailureReason, Stats};
 use crate::elements::{Energies, EvalContext, NodeState};
-use crate::model::NewtonSettings;
+use crate::model::{NewtonSettings, Scheme};
 use crate::rotation;
 use nalgebra::Vector3;
 
@@ -47,25 +51,63 @@ fn nan_max(a: f64, b: f64) -> f64 {
     }
 }
 
-/// HHT parameters derived from α.
+/// Coefficients of the generalized-α family (Chung & Hulbert 1993) in the Lie-group form
+/// of Arnold & Brüls (2007): the pseudo-acceleration `a` of
+/// `(1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) v̇_{n+1} + α_f v̇_n` drives
+/// `u = h v_n + h²(½ − β) a_n + h² β a_{n+1}` and `v_{n+1} = v_n + h(1 − γ) a_n + hγ a_{n+1}`.
+/// HHT is the member `α_m = 0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HhtParams {
-    /// `α_f = −α`.
+pub struct AlphaParams {
+    /// `α_m` (0 for HHT; `(2ρ∞ − 1)/(ρ∞ + 1)` for generalized-α).
+    pub alpha_m: f64,
+    /// `α_f` (`−α` for HHT; `ρ∞/(ρ∞ + 1)` for generalized-α).
     pub alpha_f: f64,
-    /// `β = (1 − α)²/4`.
+    /// `β = ¼(γ + ½)²`.
     pub beta: f64,
-    /// `γ = ½ − α`.
+    /// `γ = ½ + α_f − α_m` (second order).
     pub gamma: f64,
 }
 
-impl HhtParams {
-    /// Parameters of HHT-α (α ∈ [−1/3, 0]).
+impl AlphaParams {
+    /// Parameters of HHT-α (α ∈ [−1/3, 0]): `α_m = 0`, `α_f = −α`, `β = (1 − α)²/4`,
+    /// `γ = ½ − α` (Hilber, Hughes & Taylor 1977 in Arnold & Brüls' form).
     pub fn new(alpha: f64) -> Self {
-        HhtParams {
+        AlphaParams {
+            alpha_m: 0.0,
             alpha_f: -alpha,
             beta: (1.0 - alpha) * (1.0 - alpha) / 4.0,
             gamma: 0.5 - alpha,
         }
+    }
+
+    /// Parameters of generalized-α with spectral radius at infinity `ρ∞ ∈ [0, 1]`
+    /// (Chung & Hulbert 1993, eqs. 25 and 17; Arnold & Brüls 2007, §3):
+    /// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ + α_f − α_m`,
+    /// `β = ¼(γ + ½)²`.
+    pub fn generalized(rho_inf: f64) -> Self {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        AlphaParams {
+            alpha_m,
+            alpha_f,
+            beta: 0.25 * (gamma + 0.5) * (gamma + 0.5),
+            gamma,
+        }
+    }
+
+    /// The coefficients of a scheme of the α family.
+    pub fn of(scheme: &Scheme) -> Self {
+        match *scheme {
+            Scheme::Hht { alpha } => AlphaParams::new(alpha),
+            Scheme::GeneralizedAlpha { rho_inf } => AlphaParams::generalized(rho_inf),
+        }
+    }
+
+    /// `∂v̇_{n+1}/∂u = (1 − α_m)/((1 − α_f) β h²)`: the mass coefficient `c_a` of the
+    /// iteration matrix (and `∂v/∂u = γ/(βh)` its damping coefficient `c_v`).
+    pub fn c_a(&self, h: f64) -> f64 {
+        (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * h * h)
     }
 }
 
@@ -85,8 +127,10 @@ pub struct Integrator {
     pub stats: Stats,
     /// Newton settings.
     pub newton: NewtonSettings,
-    /// HHT parameters.
-    pub hht: HhtParams,
+    /// The time integration scheme (what the deck asked for).
+    pub scheme: Scheme,
+    /// Its coefficients (the α family).
+    pub params: AlphaParams,
     /// Dynamic (true) or static analysis.
     pub dynamic: bool,
     /// Constraint scale `s` currently used for `lambda`.
@@ -183,7 +227,7 @@ pub struct StepInfo {
 impl Integrator {
     /// A state at rest in the reference configuration (initial velocities applied by
     /// [`Integrator::set_velocities`]).
-    pub fn new(sys: System, newton: NewtonSettings, alpha: f64, dynamic: bool) -> Self {
+    pub fn new(sys: System, newton: NewtonSettings, scheme: Scheme, dynamic: bool) -> Self {
         let nodes: Vec<NodeState> = sys.x0.iter().map(|x| NodeState::at_rest(*x)).collect();
         let n = sys.n_eq();
         let nn = nodes.len();
@@ -203,7 +247,8 @@ impl Integrator {
             t: 0.0,
             stats: Stats::default(),
             newton,
-            hht: HhtParams::new(alpha),
+            scheme,
+            params: AlphaParams::of(&scheme),
             dynamic,
             scale: 1.0,
             mass_ref: 0.0,
@@ -240,11 +285,8 @@ impl Integrator {
 
     fn context(&self, t: f64, h: f64, scale: f64) -> EvalContext {
         let (c_v, c_a) = if self.dynamic && h > 0.0 {
-            let p = &self.hht;
-            (
-                p.gamma / (p.beta * h),
-                1.0 / ((1.0 - p.alpha_f) * p.beta * h * h),
-            )
+            let p = &self.params;
+            (p.gamma / (p.beta * h), p.c_a(h))
         } else {
             (0.0, 0.0)
         };
@@ -265,7 +307,7 @@ impl Integrator {
     /// constraint rows keep the size of the others whatever `h`.
     fn scale_for(&self, h: f64) -> f64 {
         let ca = if self.dynamic && h > 0.0 {
-            1.0 / ((1.0 - self.hht.alpha_f) * self.hht.beta * h * h)
+            self.params.c_a(h)
         } else {
             0.0
         };
@@ -287,7 +329,7 @@ impl Integrator {
     }
 
     /// The evaluation context of a step of size `h` from the current state: time `t + h`
-    /// and the HHT coefficients `c_v = γ/(βh)`, `c_a = 1/((1 − α_f)βh²)` the step uses
+    /// and the coefficients `c_v = γ/(βh)`, `c_a = (1 − α_m)/((1 − α_f)βh²)` the step uses
     /// (for benchmarks and tools that assemble outside [`Self::try_step`]).
     pub fn step_context(&self, h: f64) -> EvalContext {
         self.context(self.t + h, h, self.scale)

@@ -11,10 +11,10 @@ pub mod redundancy;
 pub mod state;
 pub mod system;
 
-pub use integrator::{HhtParams, Integrator, StepInfo};
+pub use integrator::{AlphaParams, Integrator, StepInfo};
 pub use system::{BuildError, System};
 
-use crate::model::{Analysis, Model};
+use crate::model::{Analysis, Model, Scheme};
 use std::time::Instant;
 
 /// Counters of a run (written to `summary.json`).
@@ -214,10 +214,12 @@ pub enum RunError {
 pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     let sys = System::new(model)?;
     let mut integ = match &model.analysis {
-        Analysis::Dynamic { alpha, newton, .. } => {
-            Integrator::new(sys, newton.clone(), *alpha, true)
+        Analysis::Dynamic { scheme, newton, .. } => {
+            Integrator::new(sys, newton.clone(), *scheme, true)
         }
-        Analysis::Static { newton, .. } => Integrator::new(sys, newton.clone(), 0.0, false),
+        Analysis::Static { newton, .. } => {
+            Integrator::new(sys, newton.clone(), Scheme::Hht { alpha: 0.0 }, false)
+        }
     };
     if integ.dynamic {
         for iv in &model.initial {
@@ -312,6 +314,17 @@ pub fn run_from(
         .flat_map(|f| f.breakpoints())
         .filter(|t| *t > 0.0 && *t < end)
         .collect();
+    // Drivers' breakpoints too: there a prescribed acceleration may jump (the haversine's
+    // ends), and the accelerations restart from the law's new value once a step lands on
+    // one (as after a contact's touch: no step straddles the jump).
+    let mut drive_breaks: Vec<f64> = model
+        .driver_functions()
+        .iter()
+        .flat_map(|f| f.breakpoints())
+        .filter(|t| *t > 0.0 && *t < end)
+        .collect();
+    drive_breaks.sort_by(f64::total_cmp);
+    breaks.extend_from_slice(&drive_breaks);
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();
     let ctl = resume.unwrap_or(LoopState {
@@ -392,6 +405,12 @@ pub fn run_from(
                     h: h_try,
                 })?;
                 obs.progress(integ.t, end, &integ.stats);
+                if integ.dynamic
+                    && drive_breaks.iter().any(|b| (integ.t - b).abs() <= near)
+                    && integ.consistent_accelerations().is_ok()
+                {
+                    integ.stats.restarts += 1;
+                }
                 good += 1;
                 if adaptive {
                     // The local error estimate proposes the next step; it is taken from

@@ -430,6 +430,20 @@ impl System {
             .sum()
     }
 
+    /// Power the drivers deliver at the state, W ([`Element::input_power`]); `lambda`
+    /// holds the multipliers scaled by `ctx.constraint_scale`.
+    pub fn input_power(&self, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64]) -> f64 {
+        self.elements
+            .iter()
+            .enumerate()
+            .filter(|(_, el)| el.rheonomic())
+            .map(|(e, el)| {
+                let o = self.mult_offset[e];
+                el.input_power(ctx, nodes, &lambda[o..o + el.multipliers()])
+            })
+            .sum()
+    }
+
     /// Human-readable name of a global equation, e.g. `node 23 uy`.
     pub fn describe(&self, eq: usize) -> String {
         const NAMES: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::deck::load_deck;
-use crate::model::Analysis;
+use crate::model::{Analysis, Scheme};
 use std::io::Write;
 
 /// `mecano-rs study DECK`: arguments.
@@ -17,9 +17,15 @@ pub struct StudyArgs {
     /// number in rad).
     #[arg(long, value_delimiter = ',')]
     pub adaptive: Vec<f64>,
-    /// HHT α values of the fixed-step runs, comma-separated (default: the deck's).
+    /// HHT α values of the fixed-step runs, comma-separated (default: the deck's); the
+    /// same as `--integrator hht:α,…`, before the `--integrator` ones.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub alpha: Vec<f64>,
+    /// Time integrators of the fixed-step runs, comma-separated, one ladder of steps and one
+    /// line of the diagram each: `hht[:α]`, `genalpha[:ρ∞]` (default: the deck's). The first
+    /// one's finest run is the reference and its scheme the adaptive runs'.
+    #[arg(long, value_delimiter = ',', value_parser = parse_scheme)]
+    pub integrator: Vec<Scheme>,
     /// Nodes whose histories are compared (default: the deck's OUTPUT nodes).
     #[arg(long, value_delimiter = ',')]
     pub nodes: Vec<u32>,
@@ -46,6 +52,24 @@ pub struct StudyArgs {
     /// `--refine` factor; the mesh levels are ordered by k·p.
     #[arg(long, value_delimiter = ',')]
     pub order: Vec<u32>,
+}
+
+/// `--integrator`'s values ([`Scheme::parse`]).
+fn parse_scheme(s: &str) -> Result<Scheme, String> {
+    Scheme::parse(s).map_err(|e| e.to_string())
+}
+
+impl StudyArgs {
+    /// The schemes asked for: `--alpha`'s as HHT, then `--integrator`'s (empty: the deck's).
+    pub fn schemes(&self) -> Vec<Scheme> {
+        let mut v: Vec<Scheme> = self
+            .alpha
+            .iter()
+            .map(|&alpha| Scheme::Hht { alpha })
+            .collect();
+        v.extend(self.integrator.iter().copied());
+        v
+    }
 }
 
 /// Runs `mecano-rs study` and returns the exit code (0, or 2 for bad input).
@@ -87,7 +111,7 @@ pub fn run(args: &StudyArgs) -> u8 {
     let opts = StudyOptions {
         steps,
         adaptive: args.adaptive.clone(),
-        alphas: args.alpha.clone(),
+        schemes: args.schemes(),
         nodes,
         window: args.window,
         floor: args.floor,
@@ -122,9 +146,10 @@ pub fn run(args: &StudyArgs) -> u8 {
 
 /// The space–time study (`--refine` with several factors, or `--order`).
 fn run_space(args: &StudyArgs, steps: Vec<f64>, nodes: Vec<u32>, out_dir: PathBuf) -> u8 {
-    if !args.adaptive.is_empty() || args.alpha.len() > 1 {
+    let schemes = args.schemes();
+    if !args.adaptive.is_empty() || schemes.len() > 1 {
         eprintln!(
-            "error: {}: a space-time study (several --refine factors, or --order) runs fixed steps at the deck's alpha: drop --adaptive and --alpha",
+            "error: {}: a space-time study (several --refine factors, or --order) runs fixed steps with one integrator (the deck's, or one --integrator / --alpha): drop --adaptive and the others",
             args.deck.display()
         );
         return crate::app::EXIT_BAD_INPUT;
@@ -138,6 +163,7 @@ fn run_space(args: &StudyArgs, steps: Vec<f64>, nodes: Vec<u32>, out_dir: PathBu
         floor: args.floor,
         t_max: args.until,
         out_dir: out_dir.clone(),
+        scheme: schemes.first().copied(),
     };
     let report = match space::run_space_time(&args.deck, &opts, |s| eprintln!("{s}")) {
         Ok(r) => r,

@@ -62,20 +62,20 @@ fn draw_wp<DB: plotters::prelude::DrawingBackend>(
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(|e| e.to_string())?;
-        let mut alphas: Vec<f64> = r
+        let mut schemes: Vec<crate::model::Scheme> = r
             .runs
             .iter()
             .filter(|x| x.tol.is_none())
-            .map(|x| x.alpha)
+            .map(|x| x.scheme)
             .collect();
-        alphas.dedup();
-        let colors = [BLUE, RED, GREEN, MAGENTA];
-        for (k, a) in alphas.iter().enumerate() {
+        schemes.dedup();
+        let colors = [BLUE, RED, GREEN, MAGENTA, CYAN];
+        for (k, a) in schemes.iter().enumerate() {
             let s: Vec<(f64, f64)> = r
                 .runs
                 .iter()
                 .filter(|x| {
-                    x.tol.is_none() && x.alpha == *a && x.error[c] > 0.0 && x.error[c].is_finite()
+                    x.tol.is_none() && x.scheme == *a && x.error[c] > 0.0 && x.error[c].is_finite()
                 })
                 .map(|x| (x.stats.cpu_seconds, x.error[c]))
                 .collect();
@@ -83,7 +83,7 @@ fn draw_wp<DB: plotters::prelude::DrawingBackend>(
             chart
                 .draw_series(LineSeries::new(s.clone(), col.stroke_width(2)))
                 .map_err(|e| e.to_string())?
-                .label(format!("fixed steps, alpha = {a}"))
+                .label(format!("fixed steps, {a}"))
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
                 });

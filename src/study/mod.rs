@@ -50,8 +50,9 @@ pub struct StudyOptions {
     pub steps: Vec<f64>,
     /// Adaptive position tolerances, m (rotation tolerance = position tolerance / m).
     pub adaptive: Vec<f64>,
-    /// HHT α values of the fixed-step runs (default: the deck's).
-    pub alphas: Vec<f64>,
+    /// Time integration schemes of the fixed-step runs, one ladder each (default: the
+    /// deck's); the first one's finest run is the reference, its scheme the adaptive runs'.
+    pub schemes: Vec<crate::model::Scheme>,
     /// User node numbers whose histories are compared (default: the deck's output nodes).
     pub nodes: Vec<u32>,
     /// Window length, s.
@@ -72,12 +73,12 @@ pub struct StudyOptions {
 /// One run of the study.
 #[derive(Debug, Clone)]
 pub struct StudyRun {
-    /// Label, e.g. `h=1.0e-4 a=-0.1` or `adaptive tol=1e-5`.
+    /// Label, e.g. `h=1.000e-4 hht:-0.1` or `adaptive tol=1.0e-5 hht:-0.1`.
     pub label: String,
     /// Fixed step (or the initial step of an adaptive run), s.
     pub h: f64,
-    /// HHT α.
-    pub alpha: f64,
+    /// Time integration scheme.
+    pub scheme: crate::model::Scheme,
     /// Adaptive position tolerance, m.
     pub tol: Option<f64>,
     /// Counters.

@@ -33,7 +33,7 @@ pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
     w.write_record([
         "run",
         "h",
-        "alpha",
+        "integrator",
         "adaptive_tol",
         "cpu_seconds",
         "steps",
@@ -56,7 +56,7 @@ pub fn write_results(r: &StudyReport, dir: &Path) -> io::Result<()> {
         w.write_record([
             run.label.clone(),
             format!("{:e}", run.h),
-            run.alpha.to_string(),
+            run.scheme.label(),
             run.tol.map_or(String::new(), |t| format!("{t:e}")),
             format!("{:.4}", run.stats.cpu_seconds),
             run.stats.steps.to_string(),

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::deck::load_deck;
-use crate::model::{Adaptive, Analysis, Model, NodeId};
+use crate::model::{Adaptive, Analysis, Model, NodeId, Scheme};
 use crate::rotation;
 use crate::solver::{Observer, Snapshot};
 use nalgebra::{Matrix3, Vector3};
@@ -59,9 +59,9 @@ pub(super) fn sample(recs: &[Rec], t: f64) -> Option<Rec> {
     Some(Rec { t, x, v, r })
 }
 
-pub(super) fn set_run(model: &mut Model, h: f64, alpha: f64, tol: Option<f64>, t_end: f64) {
+pub(super) fn set_run(model: &mut Model, h: f64, sch: Scheme, tol: Option<f64>, t_end: f64) {
     if let Analysis::Dynamic {
-        alpha: a,
+        scheme,
         step,
         end,
         min_step,
@@ -70,7 +70,7 @@ pub(super) fn set_run(model: &mut Model, h: f64, alpha: f64, tol: Option<f64>, t
         ..
     } = &mut model.analysis
     {
-        *a = alpha;
+        *scheme = sch;
         *step = h;
         *end = t_end;
         *min_step = (h / 1024.0).min(*min_step);
@@ -99,7 +99,7 @@ pub fn run_study(
         base.refine(opts.refine)
             .map_err(|e| StudyError::Setup(format!("--refine {}: {e}", opts.refine)))?;
     }
-    let Analysis::Dynamic { alpha, end, .. } = base.analysis else {
+    let Analysis::Dynamic { scheme, end, .. } = base.analysis else {
         return Err(StudyError::Setup("a study needs a dynamic analysis".into()));
     };
     let mut steps = opts.steps.clone();
@@ -120,19 +120,19 @@ pub fn run_study(
     if node_idx.is_empty() {
         return Err(StudyError::Setup("no nodes to compare".into()));
     }
-    let alphas = if opts.alphas.is_empty() {
-        vec![alpha]
+    let schemes = if opts.schemes.is_empty() {
+        vec![scheme]
     } else {
-        opts.alphas.clone()
+        opts.schemes.clone()
     };
-    let mut configs: Vec<(f64, f64, Option<f64>)> = Vec::new();
-    for &a in &alphas {
+    let mut configs: Vec<(f64, Scheme, Option<f64>)> = Vec::new();
+    for &a in &schemes {
         for &h in &steps {
             configs.push((h, a, None));
         }
     }
     for &tol in &opts.adaptive {
-        configs.push((steps[steps.len() / 2], alphas[0], Some(tol)));
+        configs.push((steps[steps.len() / 2], schemes[0], Some(tol)));
     }
     let mut records = Vec::new();
     let mut runs = Vec::new();
@@ -140,8 +140,8 @@ pub fn run_study(
         let mut m = base.clone();
         set_run(&mut m, *h, *a, *tol, t_end);
         let label = match tol {
-            None => format!("h={h:.3e} alpha={a}"),
-            Some(t) => format!("adaptive tol={t:.1e} alpha={a}"),
+            None => format!("h={h:.3e} {}", a.label()),
+            Some(t) => format!("adaptive tol={t:.1e} {}", a.label()),
         };
         log(&format!("running {label} …"));
         let mut rec = Recorder {
@@ -152,7 +152,7 @@ pub fn run_study(
         runs.push(StudyRun {
             label,
             h: *h,
-            alpha: *a,
+            scheme: *a,
             tol: *tol,
             stats: report.stats,
             complete: report.failure.is_none(),
@@ -173,7 +173,7 @@ pub fn run_study(
     let n_samples = (t_end / dt).round() as usize;
     let nwin = ((t_end / opts.window).ceil() as usize).max(1);
     let windows: Vec<f64> = (0..nwin).map(|k| k as f64 * opts.window).collect();
-    // Reference: the finest fixed run of the first α.
+    // Reference: the finest fixed run of the first scheme.
     let nfix = steps.len();
     let ref_i = nfix - 1;
     let errors_between = |a: usize, b: usize| -> Vec<[f64; 3]> {
@@ -223,8 +223,9 @@ pub fn run_study(
         }
         run.error = e;
     }
-    // Observed order between successive fixed runs of the first α, over converged windows.
-    for i in 0..nfix.saturating_sub(2) {
+    // Observed order between successive fixed runs of each scheme, over converged windows.
+    for i in (0..schemes.len()).flat_map(|k| (0..nfix.saturating_sub(2)).map(move |j| k * nfix + j))
+    {
         let a = errors_between(i, i + 1);
         let b = errors_between(i + 1, i + 2);
         // Positions, or rotations where no chosen node moves (a spinning body).
@@ -240,10 +241,11 @@ pub fn run_study(
             }
         }
         if na > 0.0 && nb > 0.0 {
-            runs[i].order = Some((na / nb).log2() / (steps[i] / steps[i + 1]).log2());
+            let j = i % nfix;
+            runs[i].order = Some((na / nb).log2() / (steps[j] / steps[j + 1]).log2());
         }
     }
-    // Adaptive runs against the fixed runs of the first α at the same error (position, or
+    // Adaptive runs against the fixed runs of the first scheme at the same error (position, or
     // rotation where the chosen nodes do not translate, as in the diagram).
     let c = compared_quantity(&runs);
     let fixed: Vec<(f64, f64, f64)> = runs[..nfix]

@@ -6,6 +6,8 @@
 //! Each test file compiles this module on its own, and uses only part of it.
 #![allow(dead_code)]
 
+pub mod impact;
+
 use mecano::deck::load_deck;
 use mecano::model::Model;
 use std::path::{Path, PathBuf};

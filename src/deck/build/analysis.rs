@@ -2,6 +2,7 @@
 
 use super::cursor::*;
 use super::*;
+use crate::model::Scheme;
 
 impl Builder<'_> {
     // ---------------------------------------------------------------- LOADS
@@ -129,8 +130,8 @@ impl Builder<'_> {
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
-                "ALPHA", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT",
-                "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
+                "ALPHA", "GENALPHA", "RHOINF", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE",
+                "TOLPOS", "TOLROT", "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
             ]
         } else {
             &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
@@ -138,6 +139,8 @@ impl Builder<'_> {
         let mut seen = Seen::default();
         let mut newton = NewtonSettings::default();
         let mut alpha = -0.1;
+        // `GENALPHA` (its span, to place a conflict with ALPHA) and `RHOINF ρ`.
+        let (mut genalpha, mut rho_inf) = (None, None);
         let (mut step, mut end, mut min, mut max) = (None, None, None, None);
         let (mut tolpos, mut tolrot, mut growth, mut steps) = (None, None, 2.0, 1);
         let mut adaptive = None;
@@ -149,9 +152,15 @@ impl Builder<'_> {
             seen.add(kw, ks, &c.ctx)?;
             match kw {
                 "ALPHA" => {
-                    alpha = c.number_in("ALPHA (HHT)", "-1/3 <= alpha <= 0", |v| {
-                        (-1.0 / 3.0 - 1e-12..=0.0).contains(&v)
-                    })?
+                    alpha = c.number_in("ALPHA (HHT)", "-1/3 <= alpha <= 0", Scheme::alpha_ok)?
+                }
+                "GENALPHA" => genalpha = Some(ks),
+                "RHOINF" => {
+                    rho_inf = Some(c.number_in(
+                        "RHOINF (generalized-alpha)",
+                        "0 <= rho_inf <= 1",
+                        Scheme::rho_inf_ok,
+                    )?)
                 }
                 "STEP" => step = Some(c.number("STEP (time step)")?),
                 "END" => end = Some(c.number_in("END (end time)", "> 0 s", pos)?),
@@ -237,8 +246,26 @@ impl Builder<'_> {
                     None
                 }
             };
+            let scheme = match genalpha {
+                Some(gs) if seen.has("ALPHA") => {
+                    return Err(conflict("ALPHA", "GENALPHA", &c.ctx, gs));
+                }
+                Some(_) => Scheme::GeneralizedAlpha {
+                    rho_inf: rho_inf.unwrap_or(Scheme::DEFAULT_RHO_INF),
+                },
+                None if seen.has("RHOINF") => {
+                    return Err(DeckError::new(
+                        K::MissingKeyword {
+                            context: format!("RHOINF in {}", c.ctx),
+                            expected: "GENALPHA".into(),
+                        },
+                        c.end_span(),
+                    ));
+                }
+                None => Scheme::Hht { alpha },
+            };
             Analysis::Dynamic {
-                alpha,
+                scheme,
                 step: h,
                 end,
                 min_step,

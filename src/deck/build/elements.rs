@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 9] = [
+        const TYPES: [&str; 11] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -39,6 +39,8 @@ impl Builder<'_> {
             "PRISMATIC",
             "RIGID",
             "CAME",
+            "PRESCRIBED",
+            "CLEARANCE",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -107,31 +109,37 @@ impl Builder<'_> {
                 // Report the first mistake in reading order: nodes come before MAT.
                 self.node_ref(n1.0, n1.1)?;
                 self.node_ref(n2.0, n2.1)?;
-                let (mat, ms) = mat.ok_or_else(|| miss("MAT <material number>"))?;
                 let (sec, ss) = sec.ok_or_else(|| miss("SEC <section number>"))?;
-                if !self.materials.contains_key(&MaterialId(mat)) {
-                    return Err(DeckError::new(
-                        K::Undefined {
-                            what: "material",
-                            id: mat,
-                        },
-                        ms,
-                    ));
-                }
-                if !self.sections.contains_key(&SectionId(sec)) {
-                    return Err(DeckError::new(
-                        K::Undefined {
-                            what: "section",
-                            id: sec,
-                        },
-                        ss,
-                    ));
-                }
+                let Some(section) = self.sections.get(&SectionId(sec)) else {
+                    let what = "section";
+                    return Err(DeckError::new(K::Undefined { what, id: sec }, ss));
+                };
+                // A section of properties per unit length takes no material.
+                let material = match (section.needs_material(), mat) {
+                    (true, None) => return Err(miss("MAT <material number>")),
+                    (true, Some((m, ms))) => {
+                        if !self.materials.contains_key(&MaterialId(m)) {
+                            let what = "material";
+                            return Err(DeckError::new(K::Undefined { what, id: m }, ms));
+                        }
+                        Some(MaterialId(m))
+                    }
+                    (false, None) => None,
+                    (false, Some((m, ms))) => {
+                        let (element, material, section) = (id, m, sec);
+                        let kind = K::MaterialNotUsed {
+                            element,
+                            material,
+                            section,
+                        };
+                        return Err(DeckError::new(kind, ms));
+                    }
+                };
                 return self.beams(
                     id,
                     last.unwrap_or(id),
                     (n1, n2),
-                    (MaterialId(mat), SectionId(sec)),
+                    (material, SectionId(sec)),
                     axis2.map(|(u, _, s)| (u, s)),
                     (divide.unwrap_or(1), order, arc),
                     span,
@@ -172,6 +180,10 @@ impl Builder<'_> {
                 let n2 = c.uint("second node number")?;
                 c.expect_keyword(&["AXIS"], "AXIS <x> <y> <z>")?;
                 let (axis, _, _) = c.axis(&format!("{ty} AXIS"))?;
+                if let Some(d) = self.drive_option(&mut c)? {
+                    c.finish()?;
+                    self.drives.insert(ElementId(id), d);
+                }
                 c.finish()?;
                 let kind = if ty == "HINGE" {
                     ElementKind::Hinge { axis }
@@ -187,6 +199,8 @@ impl Builder<'_> {
                 let (a1, r1, s1) = c.axis("UJOINT AXIS1")?;
                 c.expect_keyword(&["AXIS2"], "AXIS2 <x> <y> <z>")?;
                 let (a2, r2, s2) = c.axis("UJOINT AXIS2")?;
+                c.ctx = format!("element {id} (UJOINT)");
+                Self::refuse_drive(&c)?;
                 c.finish()?;
                 let dot = r1.dot(&r2).abs() / (r1.norm() * r2.norm());
                 if dot.is_nan() || dot > 1e-6 {
@@ -206,6 +220,8 @@ impl Builder<'_> {
             "SPHERICAL" | "CLAMP" => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
+                c.ctx = format!("element {id} ({ty})");
+                Self::refuse_drive(&c)?;
                 c.finish()?;
                 let kind = if ty == "CLAMP" {
                     ElementKind::Clamp
@@ -215,11 +231,26 @@ impl Builder<'_> {
                 (vec![n1, n2], kind)
             }
             "RIGID" => {
+                c.ctx = format!("element {id} (RIGID)");
+                Self::refuse_drive(&c)?;
                 let mut ns = vec![c.uint("master node number")?, c.uint("second node number")?];
                 while c.peek().is_some() {
                     ns.push(c.uint("node number")?);
                 }
                 (ns, ElementKind::Rigid)
+            }
+            "PRESCRIBED" => {
+                let (n, kind) = self.prescribed(&mut c)?;
+                (vec![n], kind)
+            }
+            "CLEARANCE" => {
+                let bearing = c.uint("bearing node number")?;
+                let journal = c.uint("journal node number")?;
+                let data = Self::clearance(&mut c)?;
+                (
+                    vec![bearing, journal],
+                    ElementKind::Clearance(Box::new(data)),
+                )
             }
             _ => {
                 let cam = c.uint("cam node number")?;
@@ -268,7 +299,7 @@ impl Builder<'_> {
         first: u32,
         last: u32,
         ((n1, s1), (n2, s2)): ((u32, Span), (u32, Span)),
-        (material, section): (MaterialId, SectionId),
+        (material, section): (Option<MaterialId>, SectionId),
         axis2: Option<(Vector3<f64>, Span)>,
         (divide, order, arc): (u32, u32, Option<(Vector3<f64>, Span)>),
         span: Span,

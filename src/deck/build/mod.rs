@@ -3,11 +3,14 @@
 
 mod analysis;
 mod checks;
+mod clearance;
 mod cursor;
+mod drives;
 mod elements;
 mod functions;
 mod nodes;
 mod properties;
+mod section;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
@@ -57,6 +60,8 @@ struct Builder<'s> {
     divide: Vec<(ElementId, u32, Span)>,
     /// The parameters in force (for the expressions of `t` of EXPR functions).
     parameters: IndexMap<String, f64>,
+    /// Driven joints (`DRIVE` on a HINGE or PRISMATIC card).
+    drives: IndexMap<ElementId, crate::model::Drive>,
 }
 
 impl<'s> Builder<'s> {
@@ -146,6 +151,7 @@ pub(crate) fn build_model(
         output: None,
         divide: Vec::new(),
         parameters,
+        drives: IndexMap::new(),
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -228,6 +234,7 @@ pub(crate) fn build_model(
         divisions: IndexMap::new(),
         parameters: b.parameters,
         order_nodes: IndexMap::new(),
+        drives: b.drives,
     };
     // Generated numbers start past every user number: divide once all are known.
     let mut numbering = crate::model::Numbering::after(&model);

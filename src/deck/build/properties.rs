@@ -1,7 +1,9 @@
 //! Stage 2, definitions: TITLE, MATERIALS, SECTIONS (FUNCTIONS: `functions.rs`).
 
 use super::cursor::*;
+use super::section::section_properties;
 use super::*;
+use crate::model::{Geometry, SectionData};
 
 impl Builder<'_> {
     // ---------------------------------------------------------------- TITLE
@@ -110,6 +112,11 @@ impl Builder<'_> {
         let (id, id_span) = c.uint("section number")?;
         c.ctx = format!("section {id}");
         let rigid = c.keyword(&["RIGID"]).is_some();
+        if c.keyword(&["PROPERTIES"]).is_some() {
+            let data = section_properties(&mut c, id, rigid)?;
+            self.add_section(id, id_span, data, rigid, span);
+            return Ok(());
+        }
         let kws: &[&'static str] = if rigid {
             &["A", "I2", "I3", "J"]
         } else {
@@ -119,7 +126,12 @@ impl Builder<'_> {
         let (mut a, mut i2, mut i3, mut j, mut k) = (None, None, None, None, 5.0 / 6.0);
         while let Some(t) = c.peek() {
             let Some((kw, ks)) = c.keyword(kws) else {
-                return Err(c.unexpected(t, &expected_list(kws)));
+                let also = if seen.0.is_empty() {
+                    " or PROPERTIES"
+                } else {
+                    ""
+                };
+                return Err(c.unexpected(t, &format!("{}{also}", expected_list(kws))));
             };
             seen.add(kw, ks, &c.ctx)?;
             let (range, ok): (&str, fn(f64) -> bool) = match (kw, rigid) {
@@ -156,23 +168,14 @@ impl Builder<'_> {
                 j.ok_or_else(|| missing("J <torsion constant>"))?,
             )
         };
-        if let Some(first) = self.sections.get(&SectionId(id)).map(|s| s.span) {
-            self.duplicate("section", id, first, id_span);
-            return Ok(());
-        }
-        self.sections.insert(
-            SectionId(id),
-            Sec {
-                id: SectionId(id),
-                area: a,
-                i2,
-                i3,
-                torsion: j,
-                shear_factor: k,
-                rigid,
-                span,
-            },
-        );
+        let geometry = Geometry {
+            area: a,
+            i2,
+            i3,
+            torsion: j,
+            shear_factor: k,
+        };
+        self.add_section(id, id_span, SectionData::Geometry(geometry), rigid, span);
         Ok(())
     }
 }

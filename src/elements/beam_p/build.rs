@@ -7,7 +7,7 @@ use crate::elements::Element;
 use crate::elements::beam::{Beam, BeamProperties, default_axis2, reference_triad};
 use crate::lagrange;
 use crate::model::arc::Arc;
-use crate::model::{ElementKind, Material, Model, Section};
+use crate::model::{ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
 
 /// The solver element of a model's beam whose nodes (dense indices, along the axis) are
@@ -28,27 +28,8 @@ pub fn from_model(
     else {
         unreachable!("from_model is called on beams only")
     };
-    let (mat, sec) = (&model.materials[material], &model.sections[section]);
-    with_properties(model, el, nodes, properties(mat, sec), mat.damping)
-}
-
-/// The per-length properties of a beam of material `mat` and section `sec`:
-/// `C_N = (EA, kGA, kGA)`, `C_M = (GJ, EI₂, EI₃)`, `ρA`, `ρ(I₂ + I₃, I₂, I₃)`.
-pub fn properties(mat: &Material, sec: &Section) -> BeamProperties {
-    BeamProperties {
-        cn: Vector3::new(
-            mat.young * sec.area,
-            sec.shear_factor * mat.shear * sec.area,
-            sec.shear_factor * mat.shear * sec.area,
-        ),
-        cm: Vector3::new(
-            mat.shear * sec.torsion,
-            mat.young * sec.i2,
-            mat.young * sec.i3,
-        ),
-        mass: mat.density * sec.area,
-        inertia: Vector3::new(sec.i2 + sec.i3, sec.i2, sec.i3) * mat.density,
-    }
+    let (props, eta) = model.beam_properties(*material, *section);
+    with_properties(model, el, nodes, props, eta)
 }
 
 /// [`from_model`] with the given properties and damping coefficient `eta` (s; the

@@ -169,6 +169,7 @@ impl Element for Came {
     }
 
     fn save_state(&self) -> ElementState {
+        let (attempt, flips, last_flag) = self.memory.save();
         ElementState::Came(CameState {
             active: self.active,
             touching: self.touching,
@@ -180,9 +181,9 @@ impl Element for Came {
             last_power: self.last_power,
             omega: self.omega,
             omega_trial: self.omega_trial.load(Ordering::Relaxed),
-            attempt: self.attempt.load(Ordering::Relaxed),
-            flips: self.flips.load(Ordering::Relaxed),
-            last_flag: self.last_flag.load(Ordering::Relaxed),
+            attempt,
+            flips,
+            last_flag,
         })
     }
 
@@ -200,9 +201,7 @@ impl Element for Came {
         self.last_power = s.last_power;
         self.omega = s.omega;
         self.omega_trial.store(s.omega_trial, Ordering::Relaxed);
-        self.attempt.store(s.attempt, Ordering::Relaxed);
-        self.flips.store(s.flips, Ordering::Relaxed);
-        self.last_flag.store(s.last_flag, Ordering::Relaxed);
+        self.memory.restore((s.attempt, s.flips, s.last_flag));
         Ok(())
     }
 

@@ -145,7 +145,7 @@ impl Came {
 }
 
 /// Smallest positive root of `g + ġ τ + ½ g̈ τ²` (the time a gap closes), if any.
-pub(super) fn first_root(g: f64, gd: f64, gdd: f64) -> Option<f64> {
+pub(crate) fn first_root(g: f64, gd: f64, gdd: f64) -> Option<f64> {
     let (a, b, c) = (0.5 * gdd, gd, g);
     if a == 0.0 {
         return (b < 0.0).then(|| -c / b);
@@ -165,7 +165,7 @@ pub(super) fn first_root(g: f64, gd: f64, gdd: f64) -> Option<f64> {
 
 /// The time in `(0, h)` where the cubic Hermite interpolant of a gap through
 /// `(0, g0, ġ0)` and `(h, g1, ġ1)` vanishes (`g0 ≥ 0 > g1`), by bisection.
-pub(super) fn hermite_root(g0: f64, gd0: f64, g1: f64, gd1: f64, h: f64) -> Option<f64> {
+pub(crate) fn hermite_root(g0: f64, gd0: f64, g1: f64, gd1: f64, h: f64) -> Option<f64> {
     if !(g0 >= 0.0 && g1 < 0.0 && h > 0.0) {
         return None;
     }

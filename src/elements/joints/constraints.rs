@@ -5,8 +5,26 @@
 use super::*;
 
 impl Joint {
-    /// The constraint functions of one pair, generic in the scalar.
+    /// The constraint functions of one pair, generic in the scalar; a driven joint's
+    /// sixth, `g(q) − target` (`target = a f(t) + 2πk`, joints/drive.rs).
     pub(super) fn phi<S: Real>(
+        &self,
+        pair: &Pair,
+        x1: &Vector3<S>,
+        r1: &Matrix3<S>,
+        x2: &Vector3<S>,
+        r2: &Matrix3<S>,
+        target: f64,
+    ) -> [S; 6] {
+        let mut phi = self.phi_joint(pair, x1, r1, x2, r2);
+        if self.drive.is_some() {
+            phi[5] = self.drive_g(x1, r1, x2, r2, &pair.c2) - c(target);
+        }
+        phi
+    }
+
+    /// The joint's own (scleronomic) equations of one pair.
+    fn phi_joint<S: Real>(
         &self,
         pair: &Pair,
         x1: &Vector3<S>,
@@ -52,8 +70,9 @@ impl Joint {
         }
     }
 
+    /// The joint's own equations at the nodes' state (a driver's row is left at 0).
     pub(super) fn phi_f64(&self, pair: &Pair, s1: &NodeState, s2: &NodeState) -> [f64; 6] {
-        self.phi(pair, &s1.x, &s1.r, &s2.x, &s2.r)
+        self.phi_joint(pair, &s1.x, &s1.r, &s2.x, &s2.r)
     }
 
     /// The generalized constraint force `Bᵀμ` of one pair, `[x₁, Θ₁, x₂, Θ₂]` (material
@@ -81,7 +100,7 @@ impl Joint {
         let zero = Vector3::<S>::zeros();
         // Multipliers of `d` (global) and of `axial(skew Q)`, and the dot-product terms.
         let first = Vector3::new(mu[0], mu[1], mu[2]);
-        let (md, mw, mut gt1, mut gt2) = match &self.kind {
+        let (mut md, mw, mut gt1, mut gt2) = match &self.kind {
             JointType::Spherical => (first, None, zero, zero),
             JointType::Hinge { p, q: qq, a } => {
                 let u = v(p) * mu[3] + v(qq) * mu[4];
@@ -101,6 +120,12 @@ impl Joint {
                 (mv(r1, &u), Some(first), u.cross(&mtv(r1, &d)), zero)
             }
         };
+        if self.drive.is_some() {
+            let (g1, g2, gd) = self.drive_grad(x1, r1, x2, r2, &c2, mu[5]);
+            gt1 += g1;
+            gt2 += g2;
+            md += gd;
+        }
         if let Some(mw) = mw {
             let tr = q[(0, 0)] + q[(1, 1)] + q[(2, 2)];
             let h = c::<S>(0.5);
@@ -123,7 +148,8 @@ impl Joint {
         ctx: &EvalContext,
         lam: &[f64],
     ) -> ([f64; 6], [f64; 12]) {
-        let phi = self.phi_f64(pair, s1, s2);
+        let target = self.drive_target(s1, s2, ctx.t);
+        let phi = self.phi(pair, &s1.x, &s1.r, &s2.x, &s2.r, target);
         let mut mu = [0.0; 6];
         for (i, m) in mu.iter_mut().enumerate().take(self.m_pair()) {
             *m = ctx.constraint_scale * lam.get(i).copied().unwrap_or(0.0) + ctx.penalty * phi[i];
@@ -160,7 +186,8 @@ impl Joint {
             rr + mm(&rr, &skew(&dth))
         };
         let (x1, r1, x2, r2) = (xs(&s1.x, 0), rs(&s1.r, 3), xs(&s2.x, 6), rs(&s2.r, 9));
-        let phi = self.phi(pair, &x1, &r1, &x2, &r2);
+        let target = self.drive_target(s1, s2, ctx.t);
+        let phi = self.phi(pair, &x1, &r1, &x2, &r2, target);
         let mut mu = [D12::constant(0.0); 6];
         for (i, m) in mu.iter_mut().enumerate().take(self.m_pair()) {
             *m = phi[i] * D12::constant(ctx.penalty) + D12::constant(ctx.constraint_scale * lam[i]);

@@ -73,7 +73,7 @@ impl Element for Joint {
     }
 
     fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {
-        let a = self.angles(nodes);
+        let a = self.angles_at(ctx.t, nodes);
         self.hist.angles = [a[0], a[1]];
         if matches!(self.kind, JointType::UJoint { .. }) {
             let cb = a[2].abs();
@@ -99,6 +99,14 @@ impl Element for Joint {
             JointType::Prismatic { .. } => vec!["slide"],
             _ => vec![],
         };
+        if self.drive.is_some() {
+            h.push("prescribed");
+            h.push(if matches!(self.kind, JointType::Hinge { .. }) {
+                "torque"
+            } else {
+                "force"
+            });
+        }
         let r = ["fx", "fy", "fz", "mx", "my", "mz"];
         if self.pairs.len() == 1 {
             h.extend(r);
@@ -119,7 +127,7 @@ impl Element for Joint {
         lambda: &[f64],
         row: &mut Vec<f64>,
     ) {
-        let a = self.angles(nodes);
+        let a = self.angles_at(ctx.t, nodes);
         match &self.kind {
             JointType::Hinge { .. } => row.push(a[0]),
             JointType::UJoint { .. } => {
@@ -131,6 +139,9 @@ impl Element for Joint {
                 row.push(d.dot(&(s1.r * ax)));
             }
             _ => {}
+        }
+        if let Some([law, _, _]) = self.drive_law(ctx.t) {
+            row.extend_from_slice(&[law, -self.drive_mu(ctx, nodes, lambda)]);
         }
         for k in 0..self.pairs.len() {
             let (f, m) = self.reaction(k, ctx, nodes, lambda);
@@ -149,6 +160,24 @@ impl Element for Joint {
                 phi[..m].iter().fold(0.0f64, |x, v| x.max(v.abs()))
             })
             .fold(0.0, f64::max)
+    }
+
+    fn rheonomic(&self) -> bool {
+        self.drive.is_some()
+    }
+
+    fn constraint_time_derivatives(&self, t: f64, k: usize) -> [f64; 2] {
+        match self.drive_law(t) {
+            Some([_, fd, fdd]) if k == 5 => [-fd, -fdd],
+            _ => [0.0; 2],
+        }
+    }
+
+    fn input_power(&self, ctx: &EvalContext, nodes: &[NodeState], lambda: &[f64]) -> f64 {
+        match self.drive_law(ctx.t) {
+            Some([_, fd, _]) => -self.drive_mu(ctx, nodes, lambda) * fd,
+            None => 0.0,
+        }
     }
 
     fn diagnose(&self, nodes: &[NodeState]) -> Option<String> {

@@ -62,6 +62,16 @@ impl Joint {
         [a[0] + wrap(r[0] - a[0]), a[1] + wrap(r[1] - a[1]), r[2]]
     }
 
+    /// [`Self::angles`] at time `t`: a driven hinge's angle is unwrapped against its law
+    /// `a f(t)` instead (exact whatever the angle turned in one step).
+    pub(super) fn angles_at(&self, t: f64, nodes: &[NodeState]) -> [f64; 3] {
+        let mut a = self.angles(nodes);
+        if let (JointType::Hinge { .. }, Some([law, _, _])) = (&self.kind, self.drive_law(t)) {
+            a[0] = self.driven_angle(self.raw_angles(nodes)[0], law);
+        }
+        a
+    }
+
     /// The diagnosis of a universal joint near its singular configuration (bend within
     /// `acos(UJOINT_SINGULAR_COS)` of 90°) at this state, or `None`.
     pub fn singularity(&self, nodes: &[NodeState]) -> Option<String> {

@@ -155,3 +155,41 @@ fn ujoint_angles_and_singularity() {
     let s = j.summary().unwrap();
     assert_eq!(s["singular_passages"], 1);
 }
+
+/// A driven HINGE and PRISMATIC (sixth equation g(q) − a f(t)): the tangent is the finite
+/// difference of the residual at large rotations and far from the law.
+#[test]
+fn driven_joints_tangent_matches_finite_differences() {
+    let a = Vector3::new(0.3, -0.5, 0.8).normalize();
+    let (p, q) = normals(&a);
+    let law = || {
+        crate::elements::drive::TimeLaw::new(
+            crate::model::Function::Haversine {
+                start: 0.0,
+                duration: 1.0,
+            },
+            40.0,
+        )
+    };
+    let x0 = [Vector3::new(0.1, 0.2, -0.1), Vector3::new(0.4, -0.1, 0.3)];
+    for kind in [
+        JointType::Hinge { p, q, a },
+        JointType::Prismatic { p, q, a },
+    ] {
+        let j = Joint::new(ElementId(7), kind, vec![0, 1], &x0)
+            .unwrap()
+            .with_drive(law())
+            .unwrap();
+        assert_eq!(j.multipliers(), 6);
+        for seed in 1..4 {
+            let st = random_states(&x0, 0.3, 1.5, seed);
+            let mut g = Lcg(seed + 100);
+            let lam: Vec<f64> = (0..6).map(|_| g.next() * 5.0).collect();
+            let c = EvalContext { t: 0.3, ..ctx() };
+            check_tangent(&j, &c, &st, &lam, 1e-7);
+        }
+    }
+    // Other joints refuse a driver.
+    let j = Joint::new(ElementId(8), JointType::Clamp, vec![0, 1], &x0).unwrap();
+    assert!(j.with_drive(law()).is_err());
+}

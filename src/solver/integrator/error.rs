@@ -9,7 +9,7 @@ impl Integrator {
     /// (Zienkiewicz & Xie, Earthquake Eng. Struct. Dyn. 20, 1991, eq. 9; the leading term
     /// of the local truncation error of Newmark-type schemes). ≤ 1 means acceptable.
     pub fn local_error(&self, h: f64, a: &crate::model::Adaptive) -> f64 {
-        let c = h * h * (self.hht.beta - 1.0 / 6.0).abs();
+        let c = h * h * (self.params.beta - 1.0 / 6.0).abs();
         let mut err: f64 = 0.0;
         for (old, new) in self.nodes.iter().zip(&self.trial) {
             err = err

@@ -1,12 +1,14 @@
-//! One HHT step on the Lie group: the trial state from Newton's increment `u`, the tangent
+//! One step of the α family (HHT, generalized-α) on the Lie group: the trial state from Newton's increment `u`, the tangent
 //! maps of the rotational increments, and the acceptance of a converged step.
 
 use super::*;
 
 impl Integrator {
-    /// Trial state from the increment `u` (HHT update formulas above).
+    /// Trial state from the increment `u` (the update formulas of the module's doc):
+    /// `a_{n+1} = (u/h² − v_n/h − (½ − β) a_n)/β`, `v_{n+1} = v_n + h((1 − γ) a_n + γ a_{n+1})`,
+    /// `v̇_{n+1} = ((1 − α_m) a_{n+1} + α_m a_n − α_f v̇_n)/(1 − α_f)`.
     pub(super) fn trial_from_u(&mut self, h: f64) {
-        let p = self.hht;
+        let p = self.params;
         for i in 0..self.nodes.len() {
             let s0 = &self.nodes[i];
             let [u_x, u_r] = self.u[i];
@@ -20,8 +22,9 @@ impl Integrator {
                 self.trial_pseudo[i] = [ax, ar];
                 t.v = s0.v + (a0x * (1.0 - p.gamma) + ax * p.gamma) * h;
                 t.w = s0.w + (a0r * (1.0 - p.gamma) + ar * p.gamma) * h;
-                t.a = (ax - s0.a * p.alpha_f) / (1.0 - p.alpha_f);
-                t.wd = (ar - s0.wd * p.alpha_f) / (1.0 - p.alpha_f);
+                let (m1, m0) = (1.0 - p.alpha_m, p.alpha_m);
+                t.a = (ax * m1 + a0x * m0 - s0.a * p.alpha_f) / (1.0 - p.alpha_f);
+                t.wd = (ar * m1 + a0r * m0 - s0.wd * p.alpha_f) / (1.0 - p.alpha_f);
             }
         }
     }
@@ -34,8 +37,15 @@ impl Integrator {
     }
 
     pub(super) fn accept(&mut self, h: f64, ctx: &EvalContext) {
+        // The drivers' power counts as external work (its multipliers at their own scale).
+        let ctx_old = EvalContext {
+            t: self.t,
+            constraint_scale: self.scale,
+            ..*ctx
+        };
         let p_old = if self.dynamic {
             self.sys.external_power(self.t, &self.nodes)
+                + self.sys.input_power(&ctx_old, &self.nodes, &self.lambda)
         } else {
             0.0
         };
@@ -59,7 +69,8 @@ impl Integrator {
         self.scale = ctx.constraint_scale;
         self.t += h;
         if self.dynamic {
-            let p_new = self.sys.external_power(self.t, &self.nodes);
+            let p_new = self.sys.external_power(self.t, &self.nodes)
+                + self.sys.input_power(ctx, &self.nodes, &self.lambda);
             self.external_work += 0.5 * (p_old + p_new) * h;
             let d_new: f64 = self
                 .sys

@@ -14,6 +14,21 @@ impl Integrator {
             .collect()
     }
 
+    /// The drivers' work over a trial step of size `h` (trapezoidal, as the loads'), J.
+    fn driver_work(&self, h: f64, ctx: &EvalContext) -> f64 {
+        if !self.sys.elements.iter().any(|e| e.rheonomic()) {
+            return 0.0;
+        }
+        let ctx_old = EvalContext {
+            t: self.t,
+            constraint_scale: self.scale,
+            ..*ctx
+        };
+        let p_old = self.sys.input_power(&ctx_old, &self.nodes, &self.lambda);
+        let p_new = self.sys.input_power(ctx, &self.trial, &self.trial_lambda);
+        0.5 * (p_old + p_new) * h
+    }
+
     pub(super) fn failure(
         &self,
         h: f64,
@@ -64,7 +79,7 @@ impl Integrator {
     /// left unchanged and a diagnosis is returned.
     pub fn try_step(&mut self, h: f64) -> Result<StepInfo, Failure> {
         let t1 = self.t + h;
-        let p = self.hht;
+        let p = self.params;
         // Rescale multipliers to this step's constraint scale.
         let s_new = if self.dynamic {
             self.scale_for(h)
@@ -77,14 +92,18 @@ impl Integrator {
         for l in &mut self.trial_lambda[nn..] {
             *l *= ratio;
         }
-        // Predictor: constant true acceleration (dynamics) or no increment (statics).
+        // Predictor: constant true acceleration (dynamics): `v̇_{n+1} = v̇_n`, so
+        // `a_{n+1} = (v̇_n − α_m a_n)/(1 − α_m)` (HHT: `a_{n+1} = v̇_n`, exactly); or no
+        // increment (statics).
         for i in 0..self.nodes.len() {
             let s = &self.nodes[i];
             self.u[i] = if self.dynamic {
                 let [a0x, a0r] = self.pseudo[i];
+                let m = 1.0 - p.alpha_m;
+                let (a1x, a1r) = ((s.a - a0x * p.alpha_m) / m, (s.wd - a0r * p.alpha_m) / m);
                 [
-                    s.v * h + (a0x * (0.5 - p.beta) + s.a * p.beta) * (h * h),
-                    s.w * h + (a0r * (0.5 - p.beta) + s.wd * p.beta) * (h * h),
+                    s.v * h + (a0x * (0.5 - p.beta) + a1x * p.beta) * (h * h),
+                    s.w * h + (a0r * (0.5 - p.beta) + a1r * p.beta) * (h * h),
                 ]
             } else {
                 [Vector3::zeros(); 2]
@@ -182,13 +201,14 @@ impl Integrator {
             if converged {
                 // A converged state must not hold energy the step cannot pay for.
                 if self.dynamic
-                    && let Some(j) = crate::solver::energy_guard::check(
+                    && let Some(j) = crate::solver::energy_guard::check_driven(
                         &self.sys,
                         &self.nodes,
                         &self.trial,
                         self.t,
                         h,
                         self.residual_floor * self.sys.ref_length,
+                        self.driver_work(h, &ctx),
                     )
                 {
                     return Err(self.failure(

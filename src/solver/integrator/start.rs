@@ -63,7 +63,10 @@ impl Integrator {
             self.scale = self.scale_for(0.0);
             return Ok(());
         }
-        self.consistent_accelerations()
+        // A driver prescribes a velocity `B v = a ḟ(0)`: the initial velocities are made
+        // consistent with it (and with every joint) before the accelerations are solved for.
+        let drivers = self.sys.elements.iter().any(|e| e.rheonomic());
+        self.consistent_start(drivers)
     }
 
     /// Consistent accelerations and multipliers at the current state, from the equations
@@ -73,6 +76,12 @@ impl Integrator {
     /// `O(h²)` in the velocities, which keeps the scheme second-order, while a step across
     /// the jump would cost `O(h)`.
     pub fn consistent_accelerations(&mut self) -> Result<(), Failure> {
+        self.consistent_start(false)
+    }
+
+    /// [`Self::consistent_accelerations`], first making the velocities consistent with
+    /// the constraints when `project` (the start of a run with drivers).
+    fn consistent_start(&mut self, project: bool) -> Result<(), Failure> {
         let n = self.sys.n_eq();
         let nn = self.sys.n_node_eq;
         let ctx0 = EvalContext {
@@ -120,6 +129,24 @@ impl Integrator {
                 }
             }
         }
+        self.lu_step = f64::NAN;
+        if let Err(e) = self.sys.matrix.factor() {
+            return Err(self.failure(
+                0.0,
+                FailureReason::Singular(e.to_string()),
+                vec![],
+                info.force_scale,
+            ));
+        }
+        self.stats.factorizations += 1;
+        if project {
+            self.project_velocities(&mut sc, s);
+            // The velocity-dependent forces at the projected velocities.
+            self.sys.assemble(&ctx_m, &self.nodes, &sc.zero, false);
+            for (r, f) in sc.rhs.iter_mut().zip(&self.sys.rhs[..nn]) {
+                *r = -f;
+            }
+        }
         // Acceleration-level constraints: s(B v̇ + Ḃv) = 0. The velocity term Ḃv is the
         // second derivative of Φ along the geodesic q exp(εv) (constant velocities), taken by
         // a central second difference (truncation O(ε²), ε|v| = 1e-3 L_ref; it is zero for
@@ -155,16 +182,8 @@ impl Integrator {
         for (r, b) in sc.rhs.iter_mut().skip(nn).zip(&sc.bdot_v) {
             *r = -b;
         }
-        self.lu_step = f64::NAN;
-        if let Err(e) = self.sys.matrix.factor() {
-            return Err(self.failure(
-                0.0,
-                FailureReason::Singular(e.to_string()),
-                vec![],
-                info.force_scale,
-            ));
-        }
-        self.stats.factorizations += 1;
+        // Drivers: s(B v̇ + Ḃv + Φ_tt) = 0.
+        self.add_time_derivatives(&mut sc.rhs, 2, s);
         let _ = self.sys.matrix.solve(&mut sc.rhs);
         let rhs = &sc.rhs;
         if rhs.iter().any(|v| !v.is_finite()) {
@@ -192,5 +211,76 @@ impl Integrator {
         self.lambda[nn..n].copy_from_slice(&rhs[nn..n]);
         self.acc = sc;
         Ok(())
+    }
+}
+
+impl Integrator {
+    /// Adds `−s ∂^{order}Φ/∂t^{order}` of every driver's constraint rows to `rhs` (order 1:
+    /// the velocity level `s(Bv + Φ_t) = 0`, order 2: the acceleration level). The laws
+    /// are read just after `t` (by 1e-12 of max(1, |t|) s): at a breakpoint of a law (where
+    /// the run restarts the accelerations) the value after its jump is the one that holds.
+    fn add_time_derivatives(&self, rhs: &mut [f64], order: usize, s: f64) {
+        let t = self.t + 1e-12 * self.t.abs().max(1.0);
+        for (e, el) in self.sys.elements.iter().enumerate() {
+            if !el.rheonomic() {
+                continue;
+            }
+            let o = self.sys.mult_offset[e];
+            for k in 0..el.multipliers() {
+                rhs[o + k] -= s * el.constraint_time_derivatives(t, k)[order - 1];
+            }
+        }
+    }
+
+    /// Makes the nodes' velocities consistent with the constraints, drivers included:
+    /// `v ← v + Δv` with `[M  sBᵀ; sB  0] [Δv; μ] = [0; −s(Bv + Φ_t)]`, the smallest change
+    /// in the kinetic-energy norm that gives `B v = −Φ_t` (`= a ḟ` for a driver). The
+    /// matrix is the factored one of the acceleration solve; `B v` is read from its
+    /// constraint rows. INITIAL velocities that contradict a driver are thus overridden
+    /// (grammar.md, "Drivers").
+    fn project_velocities(&mut self, sc: &mut AccelerationScratch, s: f64) {
+        let n = self.sys.n_eq();
+        let nn = self.sys.n_node_eq;
+        let fixed = crate::solver::system::FIXED;
+        // Velocities in equation order, into the first nn entries of `zero` (restored below).
+        let v = &mut sc.zero;
+        for (i, d) in self.sys.node_dofs.iter().enumerate() {
+            for c in 0..6 {
+                if d[c] != fixed {
+                    v[d[c]] = if c < 3 {
+                        self.nodes[i].v[c]
+                    } else {
+                        self.nodes[i].w[c - 3]
+                    };
+                }
+            }
+        }
+        let rhs = &mut sc.rp;
+        rhs.clear();
+        rhs.resize(n, 0.0);
+        for col in 0..nn {
+            for p in self.sys.matrix.position_range(col) {
+                let row = self.sys.matrix.row_of(p);
+                if row >= nn {
+                    rhs[row] -= self.sys.matrix.values[p] * v[col];
+                }
+            }
+        }
+        v.iter_mut().for_each(|x| *x = 0.0);
+        self.add_time_derivatives(rhs, 1, s);
+        if self.sys.matrix.solve(rhs).is_err() || rhs.iter().any(|x| !x.is_finite()) {
+            return;
+        }
+        for (i, d) in self.sys.node_dofs.iter().enumerate() {
+            for c in 0..6 {
+                if d[c] != fixed {
+                    if c < 3 {
+                        self.nodes[i].v[c] += rhs[d[c]];
+                    } else {
+                        self.nodes[i].w[c - 3] += rhs[d[c]];
+                    }
+                }
+            }
+        }
     }
 }

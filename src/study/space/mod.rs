@@ -62,6 +62,8 @@ pub struct SpaceTimeOptions {
     pub t_max: Option<f64>,
     /// Where to write the files and the diagram.
     pub out_dir: PathBuf,
+    /// The time integration scheme of every run (`None`: the deck's).
+    pub scheme: Option<crate::model::Scheme>,
 }
 
 /// One (mesh, step) run.
@@ -236,7 +238,7 @@ pub fn run_space_time(
 ) -> Result<SpaceTimeReport, StudyError> {
     let base =
         load_deck(path).map_err(|e| StudyError::Deck(format!("{:?}", miette::Report::new(e))))?;
-    let Analysis::Dynamic { alpha, end, .. } = base.analysis else {
+    let Analysis::Dynamic { scheme, end, .. } = base.analysis else {
         return Err(StudyError::Setup("a study needs a dynamic analysis".into()));
     };
     let mut steps = opts.steps.clone();
@@ -296,7 +298,7 @@ pub fn run_space_time(
             .filter_map(|n| m.nodes.get_index_of(&NodeId(*n)))
             .collect();
         for &h in &steps {
-            set_run(&mut m, h, alpha, None, t_end);
+            set_run(&mut m, h, opts.scheme.unwrap_or(scheme), None, t_end);
             log(&format!(
                 "running {} ({beams} beams), h = {h:.3e} s …",
                 mesh_name(k, p)

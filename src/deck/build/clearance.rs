@@ -1,0 +1,120 @@
+//! Stage 2, ELEMENTS: the `CLEARANCE` card (a revolute joint with radial clearance).
+
+use super::cursor::*;
+use super::*;
+use crate::model::{ClearanceData, ContactLaw};
+
+impl Builder<'_> {
+    /// `CLEARANCE <bearing> <journal> AXIS x y z RADIUS R CLEARANCE c LAW (KV k c | LN K e
+    /// [EXPONENT n]) [MU μ] [VREG v] [VMIN v] [IMPACT_STEPS n]`, keywords in any order.
+    pub(super) fn clearance(c: &mut Cursor<'_, '_>) -> R<ClearanceData> {
+        const KW: [&str; 9] = [
+            "AXIS",
+            "RADIUS",
+            "CLEARANCE",
+            "LAW",
+            "EXPONENT",
+            "MU",
+            "VREG",
+            "VMIN",
+            "IMPACT_STEPS",
+        ];
+        let mut seen = Seen::default();
+        let (mut axis, mut radius, mut clearance, mut law) = (None, None, None, None);
+        let (mut exponent, mut mu, mut vreg, mut vmin, mut steps) = (None, 0.0, 1e-3, 1e-4, 10);
+        while let Some(t) = c.peek() {
+            let Some((kw, ks)) = c.keyword(&KW) else {
+                return Err(c.unexpected(t, &expected_list(&KW)));
+            };
+            seen.add(kw, ks, &c.ctx)?;
+            match kw {
+                "AXIS" => axis = Some(c.axis("CLEARANCE AXIS")?.0),
+                "RADIUS" => {
+                    radius = Some(c.number_in("RADIUS (bearing radius)", "> 0 m", |v| v > 0.0)?)
+                }
+                "CLEARANCE" => {
+                    let (v, s, t) = c.number("CLEARANCE (radial clearance)")?;
+                    clearance = Some((v, s, t));
+                }
+                "LAW" => {
+                    let (ty, _) = c.expect_keyword(&["KV", "LN"], "KV or LN after LAW")?;
+                    law = Some(if ty == "KV" {
+                        let k = c.number_in("KV stiffness k", "> 0 N/m", |v| v > 0.0)?;
+                        let d = c.number_in("KV damping c", ">= 0 N·s/m", |v| v >= 0.0)?;
+                        ContactLaw::KelvinVoigt { k, c: d }
+                    } else {
+                        let k = c.number_in("LN stiffness K", "> 0 N/m^n", |v| v > 0.0)?;
+                        let e =
+                            c.number_in("LN restitution e", "in (0, 1]", |v| v > 0.0 && v <= 1.0)?;
+                        ContactLaw::LankaraniNikravesh {
+                            k,
+                            exponent: 1.5,
+                            restitution: e,
+                        }
+                    });
+                }
+                "EXPONENT" => {
+                    let (v, s, t) = c.number("EXPONENT (Hertz exponent n)")?;
+                    if v <= 0.0 {
+                        return Err(out_of_range("EXPONENT (Hertz exponent n)", t, "> 0", s));
+                    }
+                    exponent = Some((v, ks));
+                }
+                "MU" => mu = c.number_in("MU (friction coefficient)", ">= 0", |v| v >= 0.0)?,
+                "VREG" => vreg = c.number_in("VREG (friction speed)", "> 0 m/s", |v| v > 0.0)?,
+                "VMIN" => {
+                    vmin = c.number_in("VMIN (least approach speed)", "> 0 m/s", |v| v > 0.0)?
+                }
+                _ => {
+                    let (n, s) = c.uint("IMPACT_STEPS")?;
+                    if n < 1 {
+                        return Err(out_of_range("IMPACT_STEPS", "0", ">= 1", s));
+                    }
+                    steps = n;
+                }
+            }
+        }
+        let miss = |what: &str| {
+            DeckError::new(
+                K::MissingKeyword {
+                    context: c.ctx.clone(),
+                    expected: what.into(),
+                },
+                c.end_span(),
+            )
+        };
+        let axis = axis.ok_or_else(|| miss("AXIS <x> <y> <z>"))?;
+        let radius = radius.ok_or_else(|| miss("RADIUS <bearing radius>"))?;
+        let (clr, cs, ct) = clearance.ok_or_else(|| miss("CLEARANCE <radial clearance>"))?;
+        if !(clr > 0.0 && clr < radius) {
+            let range = format!("> 0 m and < RADIUS ({radius:?} m)");
+            return Err(out_of_range("CLEARANCE (radial clearance)", ct, &range, cs));
+        }
+        let mut law = law.ok_or_else(|| miss("LAW KV <k> <c> or LAW LN <K> <e>"))?;
+        if let Some((n, ns)) = exponent {
+            match &mut law {
+                ContactLaw::LankaraniNikravesh { exponent, .. } => *exponent = n,
+                ContactLaw::KelvinVoigt { .. } => {
+                    return Err(DeckError::new(
+                        K::UnknownKeyword {
+                            found: "EXPONENT".into(),
+                            context: c.ctx.clone(),
+                            expected: "EXPONENT only with LAW LN (the KV law is linear)".into(),
+                        },
+                        ns,
+                    ));
+                }
+            }
+        }
+        Ok(ClearanceData {
+            axis,
+            radius,
+            clearance: clr,
+            law,
+            friction: mu,
+            friction_speed: vreg,
+            min_approach: vmin,
+            impact_steps: steps,
+        })
+    }
+}
