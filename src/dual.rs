@@ -7,6 +7,11 @@
 //! `num_dual::DualSVec64<N>`.
 //! A kernel written once over `S: Real` gives the residual with `f64` and the exact
 //! tangent with `Dual<N>` (seed direction `k` with [`Dual::var`]).
+//! [`Jet2`] carries a value with its first and second derivatives in one variable (the
+//! exact `ḟ`, `f̈` of a deck's expression of time).
+
+mod jet;
+pub use jet::Jet2;
 
 use nalgebra::Scalar;
 use num_traits::{One, Zero};

@@ -3,6 +3,7 @@
 //! - `trajectory`: paths of chosen nodes in the XY, XZ and YZ planes (the paper's Figs. 4–6);
 //! - `history`: chosen columns of chosen nodes against time, several runs overlaid with a
 //!   legend (Fig. 7: node 23's `rx`, `vy`, `ay`, rigid vs flexible2);
+//! - `modes`: the shapes of a modal analysis in two planes and its frequencies;
 //! - `animate`: the whole model (beam, rigid-body and joint connectivity read from the deck)
 //!   in elevation (X–Y) and plan (X–Z) as an animated GIF (Fig. 3).
 //!
@@ -31,11 +32,13 @@ use std::path::{Path, PathBuf};
 mod draw;
 mod animate;
 mod history;
+mod modes;
 mod table;
 mod trajectory;
 
 pub use animate::{animate, connectivity, deck_of, refine_of};
 pub use history::history;
+pub use modes::{ModesArgs, label as modes_label, modes};
 pub use table::{Table, quantity, read_node};
 pub use trajectory::trajectory;
 
@@ -56,6 +59,8 @@ pub enum Figure {
     History(HistoryArgs),
     /// Animated GIF of the whole model in elevation (X–Y) and plan (X–Z) (paper Fig. 3).
     Animate(AnimateArgs),
+    /// The shapes of a modal analysis (`mecano-rs modes`) in two planes, and its frequencies.
+    Modes(ModesArgs),
 }
 
 /// Options shared by the figures that overlay runs.
@@ -224,6 +229,7 @@ pub fn run(args: &PlotArgs) -> u8 {
         Figure::Trajectory(a) => trajectory(a),
         Figure::History(a) => history(a),
         Figure::Animate(a) => animate(a),
+        Figure::Modes(a) => modes(a),
     };
     match res {
         Ok(path) => {

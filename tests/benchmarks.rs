@@ -206,8 +206,8 @@ fn right_angle_cantilever_energy_after_the_load() {
         .iter()
         .map(|m| {
             let w = 2.0 * std::f64::consts::PI * m.natural_hz;
-            let scheme = mecano::model::Scheme::Hht { alpha };
-            let xi = mecano::modes::hht::spectral(&scheme, w * h).damping;
+            let xi =
+                mecano::modes::hht::spectral(&mecano::model::Scheme::Hht { alpha }, w * h).damping;
             1.0 - (-2.0 * xi * w * 28.0).exp()
         })
         .fold(0.0, f64::max);

@@ -258,3 +258,23 @@ fn bad_clearance_input_is_a_located_deck_error() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!out_dir.exists(), "nothing written");
 }
+
+/// `--check` lists the clearance joint among the scene's effects (and friction when MU > 0).
+#[test]
+fn check_lists_clearance_joints_as_effects() {
+    let names = deck("clearance_orbit.dat").effects().names();
+    assert!(names.contains(&"clearance joints"), "{names:?}");
+    assert!(names.contains(&"friction"), "{names:?}");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg("--check")
+        .arg(common::deck_path("clearance_impact.dat"))
+        .output()
+        .expect("binary runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("effects:") && l.contains("clearance joints")),
+        "{text}"
+    );
+}

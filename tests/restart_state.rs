@@ -115,6 +115,22 @@ fn joints_restart_bit_for_bit() {
     check_restarts("ujoint_singular", &deck("ujoint_singular.dat"), &[0.3, 0.6]);
 }
 
+/// The ESDIRK3 integrator keeps nothing across steps but what HHT keeps (its stages are
+/// scratch): a bounce (touch, restart, release) and joints restart bit for bit with it.
+#[test]
+fn esdirk_restarts_bit_for_bit() {
+    for (name, at) in [
+        ("contact_bounce", &[0.2, 0.5, 0.8][..]),
+        ("double_pendulum_beams", &[0.25, 0.6][..]),
+    ] {
+        let mut m = deck(&format!("{name}.dat"));
+        if let Analysis::Dynamic { scheme, .. } = &mut m.analysis {
+            *scheme = mecano::model::Scheme::Esdirk3;
+        }
+        check_restarts(name, &m, at);
+    }
+}
+
 #[test]
 fn adaptive_steps_restart_bit_for_bit() {
     // The step ladder, the error estimate's proposal and a contact's step limits.
@@ -195,6 +211,22 @@ fn a_stop_at_a_pause_ends_at_that_step() {
     assert!(rep.failure.is_none());
     assert_eq!(rep.interrupted, Some(solver::Interruption::AtStep));
     assert_eq!(rep.stats.steps, 30);
+}
+
+/// The spring family's histories (issue 25 §3): a SPRING's committed direction and an
+/// RSPRING's angle with its whole turns — the flywheel given a weak torsion spring
+/// (0.01 N·m/rad), so that a restart that lost the 2 turns made before it (θ ≈ 13 rad at
+/// half time) would apply another torque.
+#[test]
+fn springs_restart_bit_for_bit() {
+    check_restarts("spring_mass", &deck("spring_mass.dat"), &[0.4]);
+    let mut m = deck("flywheel.dat");
+    for el in m.elements.values_mut() {
+        if let mecano::model::ElementKind::RSpring(r) = &mut el.kind {
+            r.stiffness = 0.01;
+        }
+    }
+    check_restarts("flywheel", &m, &[0.5]);
 }
 
 #[test]

@@ -8,11 +8,13 @@
 
 use crate::app::{self, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK};
 use crate::model::Model;
-use crate::modes::ModalAnalysis;
 pub use crate::modes::about::{
-    About, CHECK_MAX_UNKNOWNS, Failed, analyse_model, deck_step, lowest_about_initial, reach_state,
+    About, CHECK_MAX_UNKNOWNS, Failed, analyse_model, analyse_model_using, deck_step,
+    lowest_about_initial, reach_state,
 };
 use crate::modes::output::{self, DeckStep};
+use crate::modes::vtk as modes_vtk;
+use crate::modes::{ModalAnalysis, Solver};
 use crate::solver;
 use clap::Args;
 use std::io::Write as _;
@@ -49,14 +51,44 @@ pub struct ModesArgs {
     /// No table on standard output.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Eigen-solver: `auto` (sparse shift-invert Lanczos from 600 unknowns for a
+    /// conservative model, dense otherwise), `dense` or `sparse`.
+    #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
+    pub solver: SolverArg,
+}
+
+/// `--solver`'s values.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolverArg {
+    /// Sparse for large conservative models, dense otherwise.
+    Auto,
+    /// Dense (faer/nalgebra): every mode, the highest frequency.
+    Dense,
+    /// Sparse shift-invert block Lanczos: the lowest modes of a conservative model.
+    Sparse,
+}
+
+impl From<SolverArg> for Solver {
+    fn from(s: SolverArg) -> Self {
+        match s {
+            SolverArg::Auto => Solver::Auto,
+            SolverArg::Dense => Solver::Dense,
+            SolverArg::Sparse => Solver::Sparse,
+        }
+    }
 }
 
 /// Prints the modes and, for a dynamic deck, what its step resolves.
 pub fn print_table(out: &mut dyn std::io::Write, a: &ModalAnalysis, step: Option<DeckStep>) {
+    let highest = if a.highest_hz.is_finite() {
+        format!("{:.6e} Hz", a.highest_hz)
+    } else {
+        "not computed".to_string()
+    };
     let _ = writeln!(
         out,
-        "{} free unknowns, {} rigid modes, highest frequency {:.6e} Hz ({:?} solve)",
-        a.free_unknowns, a.rigid_modes, a.highest_hz, a.method
+        "{} free unknowns, {} rigid modes, highest frequency {highest} ({:?} solve)",
+        a.free_unknowns, a.rigid_modes, a.method
     );
     let _ = writeln!(out, " mode  kind       frequency Hz     damping ratio");
     for (i, m) in a.modes.iter().enumerate() {
@@ -156,7 +188,15 @@ pub fn run(args: &ModesArgs) -> u8 {
     };
     let count = args.count.or(model.modes).map_or(10, |c| c as usize);
     let dir = out_dir(args, &model);
-    run_loaded(&args.deck, &model, about, count, &dir, args.quiet)
+    run_loaded_using(
+        &args.deck,
+        &model,
+        about,
+        count,
+        &dir,
+        args.quiet,
+        args.solver.into(),
+    )
 }
 
 /// The modal analysis of a loaded model into `dir`: `mecano-rs modes`, and
@@ -170,7 +210,19 @@ pub fn run_loaded(
     dir: &Path,
     quiet: bool,
 ) -> u8 {
-    let (integ, a) = match analyse_model(model, about, count) {
+    run_loaded_using(deck, model, about, count, dir, quiet, Solver::Auto)
+}
+
+fn run_loaded_using(
+    deck: &Path,
+    model: &Model,
+    about: About,
+    count: usize,
+    dir: &Path,
+    quiet: bool,
+    solver: Solver,
+) -> u8 {
+    let (integ, a) = match analyse_model_using(model, about, count, solver) {
         Ok(r) => r,
         Err(f) => {
             eprintln!("error: {}: {}", deck.display(), f.message);
@@ -187,8 +239,18 @@ pub fn run_loaded(
         About::At(t) => format!("run to t = {t} s"),
     };
     let step = deck_step(model);
-    let summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
-    if let Err(e) = output::write_all(dir, &a, &integ.sys, &shape_nodes(model), &summary) {
+    let mut summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
+    summary["vtk"] = modes_vtk::summary(&integ.sys, &a);
+    let written = output::write_all(
+        dir,
+        &a,
+        &integ.sys,
+        &shape_nodes(model),
+        &integ.nodes,
+        &summary,
+    )
+    .and_then(|()| modes_vtk::write_series(dir, model, &integ.sys, &integ.nodes, &a));
+    if let Err(e) = written {
         eprintln!("error: writing {}: {e}", dir.display());
         return EXIT_FAILED;
     }

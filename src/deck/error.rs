@@ -71,7 +71,7 @@ pub enum DeckErrorKind {
     },
     /// An unknown element type.
     #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE"
+        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE, SPRING, BUSHING, RSPRING"
     )]
     UnknownElementType {
         /// The word.
@@ -266,6 +266,32 @@ pub enum DeckErrorKind {
         /// The previous time as written.
         previous: String,
     },
+    /// A SPLINE with an odd number of values.
+    #[error("SPLINE values come in pairs `t f`: found {count} values (an odd number)")]
+    OddSpline {
+        /// Number of values.
+        count: usize,
+    },
+    /// Points that do not make a spline (too few, times not increasing).
+    #[error("SPLINE: {reason}")]
+    BadSpline {
+        /// Why.
+        reason: crate::model::SplineError,
+    },
+    /// An EXPR function whose value or derivatives are not finite in the analysis's span.
+    #[error(
+        "function {id}: `{text}` or one of its first two time derivatives is not finite at t = {t} s (checked at 1001 instants of the analysis's span [0, {end}] s)"
+    )]
+    FunctionNotFinite {
+        /// The function's number.
+        id: u32,
+        /// The expression.
+        text: String,
+        /// The first instant found.
+        t: f64,
+        /// The analysis's end time (1 for a static one).
+        end: f64,
+    },
     /// An expression that does not parse.
     #[error("bad expression `{text}`: expected {expected}, found {found}")]
     BadExpression {
@@ -288,7 +314,7 @@ pub enum DeckErrorKind {
     },
     /// A function that expressions do not have.
     #[error(
-        "unknown function `{name}` in `{text}`: expected one of sqrt, sin, cos, exp, log, abs (or pi)"
+        "unknown function `{name}` in `{text}`: expected one of sqrt, sin, cos, exp, log, abs (or pi; t, the time, only in a FUNCTIONS EXPR)"
     )]
     UnknownFunction {
         /// The name.
@@ -368,6 +394,30 @@ pub enum DeckErrorKind {
         /// Line of the first definition.
         first_line: usize,
     },
+    /// A SPRING whose nodes coincide at t = 0.
+    #[error("SPRING element {element} joins nodes {first} and {second} at zero distance: {reason}")]
+    SpringZeroLength {
+        /// The spring.
+        element: u32,
+        /// Its first node.
+        first: u32,
+        /// Its second node.
+        second: u32,
+        /// Why that is refused.
+        reason: &'static str,
+    },
+    /// An RSPRING naming an element that is not a HINGE.
+    #[error(
+        "RSPRING element {element} names element {target}, a {found}: an RSPRING acts on a HINGE"
+    )]
+    NotAHinge {
+        /// The RSPRING.
+        element: u32,
+        /// The element it names.
+        target: u32,
+        /// That element's type keyword.
+        found: &'static str,
+    },
     /// A driver (a `DRIVE` on a joint, a `PRESCRIBED` element) that cannot be built.
     #[error("{context}: {reason}")]
     BadDrive {
@@ -436,11 +486,16 @@ impl DeckError {
             | K::PlaneParallel
             | K::UJointNotPerpendicular { .. } => "mecano::deck::axis",
             K::OutOfRange { .. } => "mecano::deck::range",
-            K::OddTable { .. } | K::DecreasingTime { .. } => "mecano::deck::table",
+            K::OddTable { .. }
+            | K::DecreasingTime { .. }
+            | K::OddSpline { .. }
+            | K::BadSpline { .. } => "mecano::deck::table",
             K::BadExpression { .. } | K::UnknownFunction { .. } | K::ExpressionTooDeep { .. } => {
                 "mecano::deck::expression"
             }
-            K::ExpressionNotFinite { .. } => "mecano::deck::expression_value",
+            K::ExpressionNotFinite { .. } | K::FunctionNotFinite { .. } => {
+                "mecano::deck::expression_value"
+            }
             K::UndefinedParameter { .. } | K::UnknownOverride { .. } => {
                 "mecano::deck::undefined_parameter"
             }
@@ -449,6 +504,7 @@ impl DeckError {
             K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
                 "mecano::deck::element"
             }
+            K::SpringZeroLength { .. } | K::NotAHinge { .. } => "mecano::deck::spring",
             K::BadDrive { .. } => "mecano::deck::drive",
         }
     }
@@ -530,7 +586,9 @@ impl DeckErrorKind {
                 cut(found);
                 cut(previous);
             }
-            K::BadExpression { text, .. } | K::ExpressionTooDeep { text, .. } => cut(text),
+            K::BadExpression { text, .. }
+            | K::ExpressionTooDeep { text, .. }
+            | K::FunctionNotFinite { text, .. } => cut(text),
             K::ExpressionNotFinite { text, what } => {
                 cut(text);
                 cut(what);

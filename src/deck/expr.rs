@@ -7,13 +7,18 @@
 //! term    = unary { ("*" | "/") unary } ;
 //! unary   = ("-" | "+") unary | power ;
 //! power   = atom [ "^" unary ] ;             (* right-associative: 2^3^2 = 2^9; -2^2 = -4 *)
-//! atom    = number | "$" name | "pi" | func "(" expr ")" | "(" expr ")" ;
+//! atom    = number | "$" name | "pi" | "t" | func "(" expr ")" | "(" expr ")" ;
 //! func    = "sqrt" | "sin" | "cos" | "exp" | "log" | "abs" ;    (* log: natural *)
 //! name    = letter { letter | digit | "_" } ;    (* letters: A-Z, a-z, _ *)
 //! ```
 //!
 //! Nesting (parentheses, function calls, signs and powers, which nest to the right) is at
 //! most [`MAX_DEPTH`] deep: a deeper expression is a located error, not a stack overflow.
+//!
+//! The time `t` is a variable only in a `FUNCTIONS … EXPR` field ([`parse_time`]), which
+//! is kept as a tree ([`crate::model::Expr`]) and evaluated at each time; anywhere else
+//! `t` is an unknown name. Every other field is evaluated when the deck is read
+//! ([`eval`]).
 //!
 //! Blanks are allowed anywhere (the lexer keeps the blanks inside parentheses within one
 //! field). Function names and `pi` are case-insensitive; parameter names are case-sensitive.
@@ -53,8 +58,7 @@ pub(crate) enum ExprErrorKind {
 /// recursive descent stays well inside a thread's stack (a few hundred bytes per level).
 pub const MAX_DEPTH: usize = 100;
 
-/// The functions an expression may call.
-pub(crate) const FUNCTIONS: [&str; 6] = ["sqrt", "sin", "cos", "exp", "log", "abs"];
+use crate::model::{BinOp, Expr, Func};
 
 /// Whether a field's text is meant as an expression (rather than a keyword or a malformed
 /// number): it contains `$`, `(`, `)`, `*`, `/` or `^`, is `pi`, or has a `+`/`-` that is
@@ -74,18 +78,47 @@ pub(crate) fn looks_like_expression(text: &str) -> bool {
 
 /// Evaluates `text` with parameter values from `lookup` (a parameter name → its value).
 pub(crate) fn eval(text: &str, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, ExprError> {
+    let node = parse(text, lookup, false)?;
+    // Without `t` every node has its value.
+    finite(node.v.unwrap_or(f64::NAN), 0, text.len(), "the expression")
+}
+
+/// Reads `text` as an expression of the time `t` into its tree, parameters replaced by
+/// their values from `lookup`. Parts that do not depend on `t` are evaluated as they are
+/// read and must be finite (`1/0` is an error here too).
+pub(crate) fn parse_time(
+    text: &str,
+    lookup: &dyn Fn(&str) -> Option<f64>,
+) -> Result<Expr, ExprError> {
+    parse(text, lookup, true).map(|n| n.e)
+}
+
+fn parse(text: &str, lookup: &dyn Fn(&str) -> Option<f64>, time: bool) -> Result<Node, ExprError> {
     let mut p = Parser {
         s: text.as_bytes(),
         pos: 0,
         depth: 0,
         lookup,
+        time,
     };
-    let v = p.expr()?;
+    let node = p.expr()?;
     p.blanks();
     if p.pos < p.s.len() {
         return Err(p.syntax("an operator (+ - * / ^) or the end of the expression"));
     }
-    finite(v, 0, text.len(), "the expression")
+    Ok(node)
+}
+
+/// A subexpression read: its tree and, when it does not depend on `t`, its value.
+struct Node {
+    e: Expr,
+    v: Option<f64>,
+}
+
+impl Node {
+    fn constant(e: Expr, v: f64) -> Self {
+        Node { e, v: Some(v) }
+    }
 }
 
 /// Whether `name` is a valid parameter name: a letter or `_`, then letters, digits, `_`.
@@ -114,6 +147,8 @@ struct Parser<'s, 'f> {
     /// Levels of [`Parser::unary`] under way: every recursive path goes through it.
     depth: usize,
     lookup: &'f dyn Fn(&str) -> Option<f64>,
+    /// Whether `t` is the time variable (an EXPR function) or an unknown name.
+    time: bool,
 }
 
 impl Parser<'_, '_> {
@@ -153,38 +188,51 @@ impl Parser<'_, '_> {
         }
     }
 
-    fn expr(&mut self) -> Result<f64, ExprError> {
+    /// `a op b`, its value checked when both are known (`start`: where `a` began).
+    fn bin(&self, op: BinOp, a: Node, b: Node, start: usize) -> Result<Node, ExprError> {
+        let what = match op {
+            BinOp::Add | BinOp::Sub => "a sum",
+            BinOp::Mul => "a product",
+            BinOp::Div => "a quotient (division by zero?)",
+            BinOp::Pow => "a power",
+        };
+        let v = match (a.v, b.v) {
+            (Some(x), Some(y)) => Some(finite(op.apply(x, y), start, self.pos - start, what)?),
+            _ => None,
+        };
+        Ok(Node {
+            e: Expr::Bin(op, Box::new(a.e), Box::new(b.e)),
+            v,
+        })
+    }
+
+    fn expr(&mut self) -> Result<Node, ExprError> {
         let start = self.pos;
         let mut v = self.term()?;
         while let Some(op @ (b'+' | b'-')) = self.peek() {
             self.pos += 1;
             let r = self.term()?;
-            v = if op == b'+' { v + r } else { v - r };
-            v = finite(v, start, self.pos - start, "a sum")?;
+            let op = if op == b'+' { BinOp::Add } else { BinOp::Sub };
+            v = self.bin(op, v, r, start)?;
         }
         Ok(v)
     }
 
-    fn term(&mut self) -> Result<f64, ExprError> {
+    fn term(&mut self) -> Result<Node, ExprError> {
         let start = self.pos;
         let mut v = self.unary()?;
         while let Some(op @ (b'*' | b'/')) = self.peek() {
             self.pos += 1;
             let r = self.unary()?;
-            v = if op == b'*' { v * r } else { v / r };
-            let what = if op == b'*' {
-                "a product"
-            } else {
-                "a quotient (division by zero?)"
-            };
-            v = finite(v, start, self.pos - start, what)?;
+            let op = if op == b'*' { BinOp::Mul } else { BinOp::Div };
+            v = self.bin(op, v, r, start)?;
         }
         Ok(v)
     }
 
     /// Every recursion of the grammar (parentheses and calls via `expr`, signs, powers)
     /// passes here, so the depth is bounded here.
-    fn unary(&mut self) -> Result<f64, ExprError> {
+    fn unary(&mut self) -> Result<Node, ExprError> {
         if self.depth >= MAX_DEPTH {
             self.blanks();
             return Err(ExprError {
@@ -202,11 +250,15 @@ impl Parser<'_, '_> {
         v
     }
 
-    fn unary_inner(&mut self) -> Result<f64, ExprError> {
+    fn unary_inner(&mut self) -> Result<Node, ExprError> {
         match self.peek() {
             Some(b'-') => {
                 self.pos += 1;
-                Ok(-self.unary()?)
+                let x = self.unary()?;
+                Ok(Node {
+                    v: x.v.map(|v| -v),
+                    e: Expr::Neg(Box::new(x.e)),
+                })
             }
             Some(b'+') => {
                 self.pos += 1;
@@ -216,14 +268,14 @@ impl Parser<'_, '_> {
         }
     }
 
-    fn power(&mut self) -> Result<f64, ExprError> {
+    fn power(&mut self) -> Result<Node, ExprError> {
         self.blanks();
         let start = self.pos;
         let base = self.atom()?;
         if self.peek() == Some(b'^') {
             self.pos += 1;
             let e = self.unary()?;
-            return finite(base.powf(e), start, self.pos - start, "a power");
+            return self.bin(BinOp::Pow, base, e, start);
         }
         Ok(base)
     }
@@ -238,7 +290,7 @@ impl Parser<'_, '_> {
         std::str::from_utf8(&self.s[start..self.pos]).unwrap_or("")
     }
 
-    fn atom(&mut self) -> Result<f64, ExprError> {
+    fn atom(&mut self) -> Result<Node, ExprError> {
         const ATOM: &str =
             "a number, `$name`, `pi`, a function (sqrt, sin, cos, exp, log, abs) or `(`";
         let Some(c) = self.peek() else {
@@ -246,7 +298,7 @@ impl Parser<'_, '_> {
         };
         let start = self.pos;
         match c {
-            b'0'..=b'9' | b'.' => self.number(),
+            b'0'..=b'9' | b'.' => self.number().map(|v| Node::constant(Expr::Num(v), v)),
             b'$' => {
                 self.pos += 1;
                 let name = self.name().to_string();
@@ -254,11 +306,14 @@ impl Parser<'_, '_> {
                     self.pos = start + 1;
                     return Err(self.syntax("a parameter name after `$` (a letter or `_` first)"));
                 }
-                (self.lookup)(&name).ok_or(ExprError {
-                    at: start,
-                    len: self.pos - start,
-                    kind: ExprErrorKind::UndefinedParameter { name },
-                })
+                match (self.lookup)(&name) {
+                    Some(value) => Ok(Node::constant(Expr::Param { name, value }, value)),
+                    None => Err(ExprError {
+                        at: start,
+                        len: self.pos - start,
+                        kind: ExprErrorKind::UndefinedParameter { name },
+                    }),
+                }
             }
             b'(' => {
                 self.pos += 1;
@@ -269,31 +324,42 @@ impl Parser<'_, '_> {
             c if c.is_ascii_alphabetic() || c == b'_' => {
                 let name = self.name().to_ascii_lowercase();
                 if name == "pi" {
-                    return Ok(std::f64::consts::PI);
+                    let pi = std::f64::consts::PI;
+                    return Ok(Node::constant(Expr::Num(pi), pi));
+                }
+                if name == "t" && self.time {
+                    return Ok(Node {
+                        e: Expr::Time,
+                        v: None,
+                    });
                 }
                 let len = self.pos - start;
-                if !FUNCTIONS.contains(&name.as_str()) {
+                let Some(func) = Func::from_name(&name) else {
                     return Err(ExprError {
                         at: start,
                         len,
                         kind: ExprErrorKind::UnknownFunction { name },
                     });
-                }
+                };
                 if self.peek() != Some(b'(') {
                     return Err(self.syntax(&format!("`(` after the function {name}")));
                 }
                 self.pos += 1;
                 let x = self.expr()?;
                 self.close()?;
-                let v = match name.as_str() {
-                    "sqrt" => x.sqrt(),
-                    "sin" => x.sin(),
-                    "cos" => x.cos(),
-                    "exp" => x.exp(),
-                    "log" => x.ln(),
-                    _ => x.abs(),
+                let v = match x.v {
+                    Some(x) => Some(finite(
+                        func.apply(x),
+                        start,
+                        self.pos - start,
+                        &format!("{name}({x})"),
+                    )?),
+                    None => None,
                 };
-                finite(v, start, self.pos - start, &format!("{name}({x})"))
+                Ok(Node {
+                    e: Expr::Call(func, Box::new(x.e)),
+                    v,
+                })
             }
             _ => Err(self.syntax(ATOM)),
         }
@@ -344,139 +410,4 @@ impl Parser<'_, '_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn params(name: &str) -> Option<f64> {
-        match name {
-            "E" => Some(2.1e11),
-            "k" => Some(4.0),
-            "m" => Some(9.0),
-            "zeta" => Some(0.05),
-            "a_1" => Some(-2.0),
-            _ => None,
-        }
-    }
-
-    fn ev(t: &str) -> Result<f64, ExprError> {
-        eval(t, &params)
-    }
-
-    #[test]
-    fn values_and_precedence() {
-        assert_eq!(ev("$E"), Ok(2.1e11));
-        assert_eq!(ev("2*$zeta*sqrt($k*$m)"), Ok(2.0 * 0.05 * 6.0));
-        assert_eq!(ev("1+2*3"), Ok(7.0));
-        assert_eq!(ev("(1+2)*3"), Ok(9.0));
-        assert_eq!(ev("2^3^2"), Ok(512.0));
-        assert_eq!(ev("-2^2"), Ok(-4.0));
-        assert_eq!(ev("2^-1"), Ok(0.5));
-        assert_eq!(ev("8/4/2"), Ok(1.0));
-        assert_eq!(ev("1-2-3"), Ok(-4.0));
-        assert_eq!(ev("--3"), Ok(3.0));
-        assert_eq!(ev("1e-3*$a_1"), Ok(-2e-3));
-        assert_eq!(ev(".5E+1"), Ok(5.0));
-        assert_eq!(ev(" ( 1 + 2 ) * 3 "), Ok(9.0));
-        assert_eq!(ev("PI"), Ok(std::f64::consts::PI));
-        assert_eq!(ev("cos(pi)"), Ok(-1.0));
-        assert_eq!(ev("SIN(0)"), Ok(0.0));
-        assert_eq!(ev("exp(log(3))"), Ok(3.0f64.ln().exp()));
-        assert_eq!(ev("abs(-$k)"), Ok(4.0));
-    }
-
-    #[test]
-    fn errors_are_located() {
-        let e = ev("2*$F").unwrap_err();
-        assert_eq!((e.at, e.len), (2, 2));
-        assert_eq!(
-            e.kind,
-            ExprErrorKind::UndefinedParameter { name: "F".into() }
-        );
-        let e = ev("2*").unwrap_err();
-        assert_eq!(e.at, 2);
-        assert!(
-            matches!(e.kind, ExprErrorKind::Syntax { ref found, .. } if found == "the end of the expression")
-        );
-        let e = ev("(1+2").unwrap_err();
-        assert_eq!(e.at, 4);
-        let e = ev("1+2)").unwrap_err();
-        assert_eq!(e.at, 3);
-        let e = ev("tan(1)").unwrap_err();
-        assert_eq!((e.at, e.len), (0, 3));
-        assert!(matches!(e.kind, ExprErrorKind::UnknownFunction { .. }));
-        let e = ev("sqrt(-1)").unwrap_err();
-        assert!(matches!(e.kind, ExprErrorKind::NotFinite { .. }));
-        assert!(matches!(
-            ev("1/(1-1)").unwrap_err().kind,
-            ExprErrorKind::NotFinite { .. }
-        ));
-        let e = ev("2.1e").unwrap_err();
-        assert_eq!(e.at, 4);
-        let e = ev("$ 1").unwrap_err();
-        assert_eq!(e.at, 1);
-        let e = ev("1 é").unwrap_err();
-        assert_eq!((e.at, e.len), (2, 2));
-        assert!(ev("").is_err());
-        assert!(ev("sqrt 2").is_err());
-    }
-
-    /// Issue 28 §2: 100,000 nested parentheses, calls, signs or powers are a located
-    /// error at the first level past [`MAX_DEPTH`], not a stack overflow.
-    #[test]
-    fn deep_nesting_is_a_located_error() {
-        let n = 100_000;
-        let cases = [
-            format!("{}1{}", "(".repeat(n), ")".repeat(n)),
-            format!("{}1{}", "sqrt(".repeat(n), ")".repeat(n)),
-            format!("{}1", "-".repeat(n)),
-            vec!["1"; n].join("^"),
-            format!("{}1", "+ -".repeat(n)),
-        ];
-        for text in &cases {
-            let e = ev(text).unwrap_err();
-            assert_eq!(e.kind, ExprErrorKind::TooDeep, "{}", &text[..20]);
-            assert!(e.at > 0 && e.at < 1000, "{}", e.at);
-        }
-        // At the limit it still evaluates: MAX_DEPTH - 1 parentheses (the outermost
-        // level is the expression itself).
-        let ok = format!(
-            "{}2{}",
-            "(".repeat(MAX_DEPTH - 1),
-            ")".repeat(MAX_DEPTH - 1)
-        );
-        assert_eq!(ev(&ok), Ok(2.0));
-        let ok = vec!["1"; MAX_DEPTH].join("^");
-        assert_eq!(ev(&ok), Ok(1.0));
-    }
-
-    #[test]
-    fn what_looks_like_an_expression() {
-        for t in ["$E", "2*3", "(1)", "pi", "1-2", "a/b", "2^2", "-$x"] {
-            assert!(looks_like_expression(t), "{t}");
-        }
-        for t in ["E", "2.1e", "2.1e-", "-", "+", "IMPACT_STEPS", "abc", "1e5"] {
-            assert!(!looks_like_expression(t), "{t}");
-        }
-    }
-
-    proptest::proptest! {
-        /// Any text: a value or a located error, never a panic, and an error's span lies
-        /// within the text on character boundaries.
-        #[test]
-        fn never_panics(s in "[-+*/^()$a-zE_0-9. é,]{0,24}") {
-            match ev(&s) {
-                Ok(v) => proptest::prop_assert!(v.is_finite()),
-                Err(e) => {
-                    proptest::prop_assert!(e.at + e.len <= s.len());
-                    proptest::prop_assert!(s.is_char_boundary(e.at) && s.is_char_boundary(e.at + e.len));
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn names() {
-        assert!(is_name("E") && is_name("_x1") && is_name("k_cont"));
-        assert!(!is_name("") && !is_name("1a") && !is_name("a-b") && !is_name("é"));
-    }
-}
+mod tests;

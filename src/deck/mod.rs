@@ -125,7 +125,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "K",
         "SECTIONS",
-        "shear correction factor (0 < k <= 1, default 5/6)",
+        "shear correction factor (0 < k <= 1, default 5/6); in ELEMENTS a stiffness (CAME, SPRING, BUSHING, RSPRING)",
     ),
     kw(
         "RIGID",
@@ -294,7 +294,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "SPLINE",
         "ELEMENTS",
-        "CAME profile: a cubic spline through points",
+        "CAME profile: a cubic spline through points (FUNCTIONS: the C² time function)",
     ),
     kw(
         "CLOSED",
@@ -344,6 +344,56 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
     kw(
+        "SPRING",
+        "ELEMENTS",
+        "two-node spring-damper along the line of its nodes (K, C, L0 or PRELOAD, CURVE)",
+    ),
+    kw(
+        "L0",
+        "ELEMENTS",
+        "SPRING: free length, m (>= 0; default: initial distance)",
+    ),
+    kw(
+        "PRELOAD",
+        "ELEMENTS",
+        "SPRING: tension at the initial distance, N (instead of L0)",
+    ),
+    kw(
+        "CURVE",
+        "ELEMENTS",
+        "SPRING: function number of a force-deflection curve F(deflection), N",
+    ),
+    kw(
+        "BUSHING",
+        "ELEMENTS",
+        "six-component linear bushing in a frame fixed to its first node",
+    ),
+    kw(
+        "AXES",
+        "ELEMENTS",
+        "BUSHING: axes e1 e2 of its frame, global at t = 0",
+    ),
+    kw(
+        "RSPRING",
+        "ELEMENTS",
+        "rotational spring, damper and friction on a HINGE element",
+    ),
+    kw(
+        "THETA0",
+        "ELEMENTS",
+        "RSPRING: unloaded angle, rad (default 0)",
+    ),
+    kw(
+        "FRICTION",
+        "ELEMENTS",
+        "RSPRING: Coulomb friction torque, N·m (>= 0)",
+    ),
+    kw(
+        "WREG",
+        "ELEMENTS",
+        "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
+    ),
+    kw(
         "CLEARANCE",
         "ELEMENTS",
         "revolute joint with radial clearance (element type; and its clearance, m)",
@@ -382,6 +432,39 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "FUNCTIONS",
         "a smooth pulse sin²(π(t−t0)/T) on [t0, t0+T]",
     ),
+    kw(
+        "SLOPES",
+        "FUNCTIONS",
+        "SPLINE: clamped end slopes (default: natural ends)",
+    ),
+    kw("SINE", "FUNCTIONS", "A sin(ω(t − t0) + φ)"),
+    kw("COSINE", "FUNCTIONS", "A cos(ω(t − t0) + φ)"),
+    kw("FREQ", "FUNCTIONS", "SINE/COSINE: frequency, Hz"),
+    kw(
+        "OMEGA",
+        "FUNCTIONS",
+        "SINE/COSINE: circular frequency, rad/s",
+    ),
+    kw(
+        "PHASE",
+        "FUNCTIONS",
+        "SINE/COSINE: phase φ, rad (default 0)",
+    ),
+    kw(
+        "START",
+        "FUNCTIONS",
+        "SINE/COSINE: start time t0, s (0 before it)",
+    ),
+    kw(
+        "RAMP",
+        "FUNCTIONS",
+        "quintic C² step from (t0, f0) to (t1, f1)",
+    ),
+    kw(
+        "EXPR",
+        "FUNCTIONS",
+        "an expression of t (exact derivatives)",
+    ),
     // loads
     kw("GRAVITY", "LOADS", "gravity acceleration vector, m/s²"),
     kw("FORCE", "LOADS", "nodal force, N, global frame"),
@@ -419,6 +502,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "generalized-alpha: spectral radius at infinity (0 <= rho <= 1, default 0.8)",
     ),
     kw("STEP", "ANALYSIS", "time step, s (> 0)"),
+    kw(
+        "ESDIRK3",
+        "ANALYSIS",
+        "third-order L-stable ESDIRK time integrator instead of HHT",
+    ),
     kw(
         "MINSTEP",
         "ANALYSIS",

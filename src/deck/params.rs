@@ -22,17 +22,22 @@ use crate::model::Span;
 use indexmap::IndexMap;
 
 /// The parameters' names as a sentence for error messages.
-fn known(params: &IndexMap<String, (f64, Span)>) -> String {
-    if params.is_empty() {
+fn known<'n>(names: impl Iterator<Item = &'n String>) -> String {
+    let names: Vec<String> = names.map(|n| format!("`{n}`")).collect();
+    if names.is_empty() {
         "no parameter is defined".into()
     } else {
-        let names: Vec<String> = params.keys().map(|n| format!("`{n}`")).collect();
         format!("defined: {}", names.join(", "))
     }
 }
 
 /// Turns an expression error in `tok` into a deck error located inside the token.
 fn deck_error(tok: &Token<'_>, e: ExprError, params: &IndexMap<String, (f64, Span)>) -> DeckError {
+    located(tok, e, || known(params.keys()))
+}
+
+/// [`deck_error`] with the parameters' sentence computed by `known` when needed.
+fn located(tok: &Token<'_>, e: ExprError, known: impl Fn() -> String) -> DeckError {
     let start = (tok.span.start + e.at).min(tok.span.end);
     let span = Span::new(start, (start + e.len).min(tok.span.end));
     let text = tok.text.to_string();
@@ -44,7 +49,7 @@ fn deck_error(tok: &Token<'_>, e: ExprError, params: &IndexMap<String, (f64, Spa
         },
         ExprErrorKind::UndefinedParameter { name } => K::UndefinedParameter {
             name,
-            known: known(params),
+            known: known(),
         },
         ExprErrorKind::UnknownFunction { name } => K::UnknownFunction { name, text },
         ExprErrorKind::NotFinite { what } => K::ExpressionNotFinite { text, what },
@@ -59,6 +64,16 @@ fn deck_error(tok: &Token<'_>, e: ExprError, params: &IndexMap<String, (f64, Spa
 /// [`deck_error`] outside a deck (no parameters defined): `--set name=value`.
 pub(crate) fn expr_error(tok: &Token<'_>, e: ExprError) -> DeckError {
     deck_error(tok, e, &IndexMap::new())
+}
+
+/// The field `tok` read as an expression of the time `t` (`FUNCTIONS … EXPR`), with the
+/// parameters' values in force; errors located inside the field.
+pub(crate) fn time_expression(
+    tok: &Token<'_>,
+    params: &IndexMap<String, f64>,
+) -> Result<crate::model::Expr, DeckError> {
+    expr::parse_time(tok.text, &|n| params.get(n).copied())
+        .map_err(|e| located(tok, e, || known(params.keys())))
 }
 
 /// The value of a field: its number, or its expression evaluated with `params`.
@@ -153,7 +168,7 @@ pub(crate) fn resolve(
             errors.push(DeckError {
                 kind: K::UnknownOverride {
                     name: name.clone(),
-                    known: known(&params),
+                    known: known(params.keys()),
                 },
                 span: None,
             });

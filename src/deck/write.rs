@@ -6,7 +6,7 @@
 
 use crate::model::{
     Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
-    Scheme, Section, SectionData, Selection,
+    Scheme, Section, SectionData, Selection, SpringLength,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
@@ -67,6 +67,16 @@ fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
             let n: Vec<String> = v.iter().map(|x| num(x).to_string()).collect();
             n.join(" ")
         }
+    }
+}
+
+/// ` t f` pairs, eight to a line (continued with `&`: a line holds at most 16 KiB).
+fn points(s: &mut String, pts: &[(f64, f64)]) {
+    for (k, (t, v)) in pts.iter().enumerate() {
+        if k > 0 && k % 8 == 0 {
+            s.push_str(" &\n   ");
+        }
+        let _ = write!(s, " {t:?} {v:?}");
     }
 }
 
@@ -137,10 +147,40 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 Function::Table(pts) => {
                     let _ = write!(s, "  {} TABLE", f.id.0);
-                    for (t, v) in pts {
-                        let _ = write!(s, " {t:?} {v:?}");
+                    points(&mut s, pts);
+                    s.push('\n');
+                }
+                Function::Spline(sp) => {
+                    let _ = write!(s, "  {} SPLINE", f.id.0);
+                    points(&mut s, sp.points());
+                    if let Some((s0, sn)) = sp.slopes() {
+                        let _ = write!(s, " SLOPES {s0:?} {sn:?}");
                     }
                     s.push('\n');
+                }
+                Function::Harmonic {
+                    cosine,
+                    amplitude,
+                    omega,
+                    phase,
+                    start,
+                } => {
+                    let kind = if *cosine { "COSINE" } else { "SINE" };
+                    let _ = write!(s, "  {} {kind} {amplitude:?} OMEGA {omega:?}", f.id.0);
+                    if *phase != 0.0 {
+                        let _ = write!(s, " PHASE {phase:?}");
+                    }
+                    if let Some(t0) = start {
+                        let _ = write!(s, " START {t0:?}");
+                    }
+                    s.push('\n');
+                }
+                Function::Ramp { t0, f0, t1, f1 } => {
+                    let _ = writeln!(s, "  {} RAMP {t0:?} {f0:?} {t1:?} {f1:?}", f.id.0);
+                }
+                Function::Expr(e) => {
+                    // As written: the same field reads back to the same tree.
+                    let _ = writeln!(s, "  {} EXPR {}", f.id.0, e.text);
                 }
             }
         }
@@ -161,7 +201,10 @@ pub fn write_deck(model: &Model) -> String {
                         .map(|n| n.0.to_string())
                         .collect()
                 }
-                None => e.nodes.iter().map(|n| n.0.to_string()).collect(),
+                None => match &e.kind {
+                    ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
+                    _ => e.nodes.iter().map(|n| n.0.to_string()).collect(),
+                },
             };
             let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
             match &e.kind {
@@ -230,6 +273,36 @@ pub fn write_deck(model: &Model) -> String {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
                 }
                 ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
+                ElementKind::Spring(p) => {
+                    let _ = write!(s, " K {:?} C {:?}", p.stiffness, p.damping);
+                    match p.length {
+                        SpringLength::Initial => {}
+                        SpringLength::Free(l) => {
+                            let _ = write!(s, " L0 {l:?}");
+                        }
+                        SpringLength::Preload(f) => {
+                            let _ = write!(s, " PRELOAD {f:?}");
+                        }
+                    }
+                    if let Some(f) = p.curve {
+                        let _ = write!(s, " CURVE {}", f.0);
+                    }
+                }
+                ElementKind::Bushing(b) => {
+                    let six = |v: &[f64; 6]| v.map(|x| format!("{x:?}")).join(" ");
+                    let _ = write!(s, " K {} C {}", six(&b.stiffness), six(&b.damping));
+                    if b.axes != Matrix3::identity() {
+                        let col = |i: usize| v3(&b.axes.column(i).into_owned());
+                        let _ = write!(s, " AXES {} {}", col(0), col(1));
+                    }
+                }
+                ElementKind::RSpring(r) => {
+                    let _ = write!(
+                        s,
+                        " K {:?} C {:?} THETA0 {:?} FRICTION {:?} WREG {:?}",
+                        r.stiffness, r.damping, r.angle0, r.friction, r.friction_speed
+                    );
+                }
                 ElementKind::Clearance(c) => {
                     let law = match c.law {
                         ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
@@ -322,6 +395,7 @@ pub fn write_deck(model: &Model) -> String {
                 Scheme::GeneralizedAlpha { rho_inf } => {
                     write!(s, "ANALYSIS DYNAMIC GENALPHA RHOINF {rho_inf:?}")
                 }
+                Scheme::Esdirk3 => write!(s, "ANALYSIS DYNAMIC ESDIRK3"),
             };
             let _ = write!(
                 s,

@@ -17,6 +17,7 @@
 
 pub mod beam;
 pub mod beam_p;
+pub mod bushing;
 pub mod came;
 pub mod clearance;
 pub mod drive;
@@ -25,6 +26,8 @@ pub mod mass;
 pub mod prescribed;
 pub mod profile;
 pub mod rigid_bar;
+pub mod rspring;
+pub mod spring;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -121,6 +124,9 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                 out.push(Box::new(c));
             }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
+            ElementKind::Spring(_) | ElementKind::Bushing(_) | ElementKind::RSpring(_) => {
+                out.push(spring::from_model(model, el)?)
+            }
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }
@@ -142,6 +148,11 @@ pub enum ElementState {
     Came(came::CameState),
     /// A joint ([`joints::Joint`]).
     Joint(joints::JointState),
+    /// A SPRING's line of action at the last accepted state ([`spring::Spring`]).
+    Spring([f64; 3]),
+    /// An RSPRING's hinge angle at the last accepted state, rad, whole turns counted
+    /// ([`rspring::RSpring`]).
+    RSpring(f64),
     /// A revolute joint with clearance ([`clearance::Clearance`]).
     Clearance(clearance::ClearanceState),
 }

@@ -164,3 +164,31 @@ pub fn static_ctx() -> EvalContext {
         ..dyn_ctx()
     }
 }
+
+/// Asserts objectivity: under a rigid motion `x ↦ Q x + b`, `R ↦ Q R` of the states, the
+/// translational rows of the residual (global forces) rotate by `Q` and the rotational rows
+/// (material moments) are unchanged, to `rel` of the largest entry.
+pub fn check_objectivity(el: &dyn Element, ctx: &EvalContext, nodes: &[NodeState], rel: f64) {
+    let n = 6 * el.nodes().len() + el.multipliers();
+    let lambda = vec![0.0; el.multipliers()];
+    let q = rotation::exp(&Vector3::new(0.7, -1.1, 0.4));
+    let moved = rigidly_moved(nodes, &q, &Vector3::new(1.0, -2.0, 0.5));
+    let r0 = residual(el, ctx, nodes, &lambda, n);
+    let r1 = residual(el, ctx, &moved, &lambda, n);
+    let scale = r0.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+    for k in 0..el.nodes().len() {
+        let t0 = Vector3::new(r0[6 * k], r0[6 * k + 1], r0[6 * k + 2]);
+        let t1 = Vector3::new(r1[6 * k], r1[6 * k + 1], r1[6 * k + 2]);
+        let m0 = Vector3::new(r0[6 * k + 3], r0[6 * k + 4], r0[6 * k + 5]);
+        let m1 = Vector3::new(r1[6 * k + 3], r1[6 * k + 4], r1[6 * k + 5]);
+        assert!(
+            (q * t0 - t1).norm() <= rel * scale,
+            "node {k}: force {t1:?} is not the rotated {:?}",
+            q * t0
+        );
+        assert!(
+            (m0 - m1).norm() <= rel * scale,
+            "node {k}: material moment {m1:?} changed from {m0:?}"
+        );
+    }
+}

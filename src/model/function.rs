@@ -4,6 +4,19 @@
 //! derivatives ([`Function::derivatives`]): a driver (a prescribed motion) needs
 //! `f, ḟ, f̈` for positions, velocities and accelerations consistent with the time
 //! integrator; a load needs only `f`.
+//!
+//! The smooth kinds, with exact derivatives: `CONSTANT`, `HAVERSINE`, the C² cubic
+//! [`CubicSpline`], the harmonic `SINE`/`COSINE`, the quintic `RAMP` and an expression of
+//! `t` ([`TimeExpr`], evaluated with second-order jets).
+
+#[cfg(test)]
+mod smooth_tests;
+mod spline;
+
+pub use spline::{CubicSpline, SplineError};
+
+use super::expr::TimeExpr;
+use std::f64::consts::PI;
 
 /// A time function `f(t)` that scales a load.
 #[derive(Debug, Clone, PartialEq)]
@@ -22,17 +35,59 @@ pub enum Function {
         /// Duration T, s (> 0).
         duration: f64,
     },
+    /// The C² cubic spline through points, natural or with clamped end slopes; a straight
+    /// line beyond its ends ([`CubicSpline`]).
+    Spline(CubicSpline),
+    /// `f(t) = A sin(ω(t − t₀) + φ)` (`cosine`: `A cos(…)`) for `t ≥ t₀`, and 0 before
+    /// the start `t₀` when one is given (then `f` jumps by `A sin φ` and `ḟ` by `A ω cos φ`
+    /// there — for the cosine `A cos φ` and `−A ω sin φ`); without a start, `t₀ = 0` and
+    /// the wave holds for every `t`. `ḟ = A ω cos(…)`, `f̈ = −A ω² sin(…)`.
+    Harmonic {
+        /// Cosine rather than sine.
+        cosine: bool,
+        /// Amplitude A.
+        amplitude: f64,
+        /// Circular frequency ω, rad/s (2π times the frequency in Hz).
+        omega: f64,
+        /// Phase φ, rad.
+        phase: f64,
+        /// Start time t₀, s, if any.
+        start: Option<f64>,
+    },
+    /// A quintic smooth step from `f₀` at `t₀` to `f₁` at `t₁`, constant outside:
+    /// `f = f₀ + (f₁ − f₀) p(s)`, `s = (t − t₀)/(t₁ − t₀)`, `p = 10s³ − 15s⁴ + 6s⁵`
+    /// (the lowest-degree polynomial with `p(0) = 0`, `p(1) = 1` and `p′`, `p″` zero at
+    /// both ends), so `f`, `ḟ`, `f̈` are continuous (C²; `f⃛` jumps by `60Δ/T³` at both
+    /// ends). `ḟ = Δ·30s²(1 − s)²/T`, peak `1.875 Δ/T` at mid-ramp;
+    /// `f̈ = Δ·60s(1 − s)(1 − 2s)/T²`, peak `(10/√3) Δ/T²` at `s = (3 ∓ √3)/6`.
+    Ramp {
+        /// Start time t₀, s.
+        t0: f64,
+        /// Value before and at t₀.
+        f0: f64,
+        /// End time t₁ > t₀, s.
+        t1: f64,
+        /// Value at and after t₁.
+        f1: f64,
+    },
+    /// An expression of `t` with the deck's expression syntax and parameters, evaluated
+    /// with second-order jets (exact `ḟ`, `f̈`).
+    Expr(TimeExpr),
 }
 
 impl Function {
     /// Value at time `t`.
     pub fn eval(&self, t: f64) -> f64 {
         match self {
+            Function::Expr(e) => e.eval(t),
+            Function::Spline(_) | Function::Harmonic { .. } | Function::Ramp { .. } => {
+                self.derivatives(t).map_or(0.0, |d| d[0])
+            }
             Function::Constant(c) => *c,
             Function::Haversine { start, duration } => {
                 let s = (t - start) / duration;
                 if (0.0..=1.0).contains(&s) {
-                    (std::f64::consts::PI * s).sin().powi(2)
+                    (PI * s).sin().powi(2)
                 } else {
                     0.0
                 }
@@ -57,11 +112,20 @@ impl Function {
         }
     }
 
-    /// Times where the function has kinks (table breakpoints), which a time integrator
-    /// should step on rather than across.
+    /// Times where the function or one of its first three derivatives jumps (table
+    /// points, a pulse's or a ramp's ends, a harmonic's start, a clamped spline's end
+    /// knots), which a time integrator should step on rather than across. A spline's
+    /// interior knots are not listed: `f`, `ḟ`, `f̈` are continuous there (only `f⃛`
+    /// jumps), nor are a natural spline's ends (its `f̈` is 0 on both sides).
     pub fn breakpoints(&self) -> Vec<f64> {
         match self {
-            Function::Constant(_) => Vec::new(),
+            Function::Constant(_) | Function::Expr(_) => Vec::new(),
+            Function::Spline(s) => match s.slopes() {
+                Some(_) => vec![s.points()[0].0, s.points()[s.points().len() - 1].0],
+                None => Vec::new(),
+            },
+            Function::Harmonic { start, .. } => start.iter().copied().collect(),
+            Function::Ramp { t0, t1, .. } => vec![*t0, *t1],
             Function::Haversine { start, duration } => vec![*start, start + duration],
             Function::Table(p) => p.iter().map(|x| x.0).collect(),
         }
@@ -81,19 +145,87 @@ impl Function {
             Function::Haversine { start, duration } => {
                 let s = (t - start) / duration;
                 if (0.0..=1.0).contains(&s) {
-                    let pi = std::f64::consts::PI;
-                    let w = 2.0 * pi * s;
+                    let w = 2.0 * PI * s;
                     Some([
-                        (pi * s).sin().powi(2),
-                        pi / duration * w.sin(),
-                        2.0 * pi * pi / (duration * duration) * w.cos(),
+                        (PI * s).sin().powi(2),
+                        PI / duration * w.sin(),
+                        2.0 * PI * PI / (duration * duration) * w.cos(),
                     ])
                 } else {
                     Some([0.0, 0.0, 0.0])
                 }
             }
+            Function::Spline(s) => Some(s.derivatives(t)),
+            Function::Harmonic {
+                cosine,
+                amplitude: a,
+                omega: w,
+                phase,
+                start,
+            } => {
+                let t0 = start.unwrap_or(0.0);
+                if start.is_some() && t < t0 {
+                    return Some([0.0, 0.0, 0.0]);
+                }
+                let x = w * (t - t0) + phase;
+                let (s, c) = (x.sin(), x.cos());
+                Some(if *cosine {
+                    [a * c, -a * w * s, -a * w * w * c]
+                } else {
+                    [a * s, a * w * c, -a * w * w * s]
+                })
+            }
+            Function::Ramp { t0, f0, t1, f1 } => {
+                let span = t1 - t0;
+                let s = ((t - t0) / span).clamp(0.0, 1.0);
+                let d = f1 - f0;
+                let p = s * s * s * (10.0 + s * (-15.0 + 6.0 * s));
+                let p1 = 30.0 * s * s * (1.0 - s) * (1.0 - s);
+                let p2 = 60.0 * s * (1.0 - s) * (1.0 - 2.0 * s);
+                Some([f0 + d * p, d * p1 / span, d * p2 / (span * span)])
+            }
+            Function::Expr(e) => Some(e.derivatives(t)),
             Function::Table(_) => None,
         }
+    }
+
+    /// The largest `|f|` over `[t0, t1]` (a reference magnitude for convergence tests):
+    /// exact for the tables, constants, pulses, waves and ramps; for a spline and an
+    /// expression, the largest over the knots in the window and 1025 evenly spaced
+    /// instants (a spline overshoots its knots by a fraction of their spread).
+    pub fn max_abs(&self, t0: f64, t1: f64) -> f64 {
+        let sampled = |extra: &mut dyn Iterator<Item = f64>| {
+            let n = 1024;
+            (0..=n)
+                .map(|k| t0 + (t1 - t0) * k as f64 / n as f64)
+                .chain(extra)
+                .filter(|t| *t >= t0 && *t <= t1)
+                .map(|t| self.eval(t).abs())
+                .filter(|v| v.is_finite())
+                .fold(0.0f64, f64::max)
+        };
+        match self {
+            Function::Constant(c) => c.abs(),
+            Function::Haversine { .. } => 1.0,
+            Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
+            Function::Harmonic { amplitude, .. } => amplitude.abs(),
+            Function::Ramp { f0, f1, .. } => f0.abs().max(f1.abs()),
+            Function::Spline(s) => sampled(&mut s.points().iter().map(|p| p.0)),
+            Function::Expr(_) => sampled(&mut std::iter::empty()),
+        }
+    }
+
+    /// The first of 1001 evenly spaced instants of `[t0, t1]` (ends included) where an
+    /// expression's value or derivatives are not finite (`log(t)` and `sqrt(t)` at 0,
+    /// `1/(t − 1)` at 1), or `None`. The other kinds are finite by construction.
+    pub fn first_non_finite(&self, t0: f64, t1: f64) -> Option<f64> {
+        let Function::Expr(e) = self else {
+            return None;
+        };
+        let n = 1000;
+        (0..=n)
+            .map(|k| t0 + (t1 - t0) * k as f64 / n as f64)
+            .find(|t| !e.expr.jet(*t).is_finite())
     }
 
     /// Whether [`Function::derivatives`] gives exact derivatives (a driver may use it).

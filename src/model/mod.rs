@@ -9,6 +9,7 @@
 pub mod arc;
 mod clearance;
 mod drive;
+mod expr;
 mod function;
 mod ids;
 mod mesh;
@@ -16,16 +17,19 @@ pub mod order;
 mod output;
 mod scheme;
 mod section;
+mod springs;
 mod summary;
 
 pub use clearance::{ClearanceData, ContactLaw};
 pub use drive::{Drive, NodeMotion};
-pub use function::Function;
+pub use expr::{BinOp, Expr, Func, TimeExpr};
+pub use function::{CubicSpline, Function, SplineError};
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};
 pub use output::{LARGE_MODEL, OutputRequest, Selection};
 pub use scheme::{Scheme, SchemeNameError};
 pub use section::{BeamProperties, Geometry, Section, SectionData};
+pub use springs::{BushingData, RSpringData, SpringData, SpringLength};
 pub use summary::{Effects, Generated, Summary};
 
 use indexmap::IndexMap;
@@ -200,6 +204,12 @@ pub enum ElementKind {
     Rigid,
     /// Cam–follower contact (first node: cam, second: follower).
     Came(Box<CameData>),
+    /// Two-node spring–damper along the line of its nodes.
+    Spring(Box<SpringData>),
+    /// Six-component linear bushing (nodes 1, 2).
+    Bushing(Box<BushingData>),
+    /// Rotational spring, damper and friction on a HINGE (the hinge's nodes).
+    RSpring(Box<RSpringData>),
     /// A prescribed motion of one node (`PRESCRIBED`, [`drive`](self::Drive)).
     Prescribed {
         /// What is prescribed.
@@ -224,6 +234,9 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => "PRISMATIC",
             ElementKind::Rigid => "RIGID",
             ElementKind::Came(_) => "CAME",
+            ElementKind::Spring(_) => "SPRING",
+            ElementKind::Bushing(_) => "BUSHING",
+            ElementKind::RSpring(_) => "RSPRING",
             ElementKind::Prescribed { .. } => "PRESCRIBED",
             ElementKind::Clearance(_) => "CLEARANCE",
         }

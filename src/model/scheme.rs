@@ -27,6 +27,10 @@ pub enum Scheme {
         /// Spectral radius at infinite frequency, `ρ∞ ∈ [0, 1]` (1: no numerical damping).
         rho_inf: f64,
     },
+    /// Kennedy & Carpenter's (2016) ESDIRK3(2)4L[2]SA on the Lie group
+    /// (`solver::integrator::esdirk`): third order, L-stable (`ρ∞ = 0`), three implicit
+    /// stages per step. Deck: `ESDIRK3`.
+    Esdirk3,
 }
 
 impl Default for Scheme {
@@ -40,7 +44,7 @@ impl Default for Scheme {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SchemeNameError {
     /// Not one of [`Scheme::NAMES`].
-    #[error("unknown integrator '{0}' (expected hht[:alpha] or genalpha[:rho_inf])")]
+    #[error("unknown integrator '{0}' (expected hht[:alpha], genalpha[:rho_inf] or esdirk3)")]
     Unknown(String),
     /// The parameter after `:` is not a number in the scheme's range.
     #[error("integrator '{name}': the parameter '{value}' is not a number in {range}")]
@@ -61,13 +65,14 @@ impl Scheme {
     pub const DEFAULT_RHO_INF: f64 = 0.8;
 
     /// The names [`Scheme::parse`] accepts (`study --integrator`).
-    pub const NAMES: &'static [&'static str] = &["hht", "genalpha"];
+    pub const NAMES: &'static [&'static str] = &["hht", "genalpha", "esdirk3"];
 
     /// Short name: `hht`, `genalpha` (command line, file columns).
     pub fn name(&self) -> &'static str {
         match self {
             Scheme::Hht { .. } => "hht",
             Scheme::GeneralizedAlpha { .. } => "genalpha",
+            Scheme::Esdirk3 => "esdirk3",
         }
     }
 
@@ -77,6 +82,7 @@ impl Scheme {
         match *self {
             Scheme::Hht { alpha } => format!("hht:{alpha}"),
             Scheme::GeneralizedAlpha { rho_inf } => format!("genalpha:{rho_inf}"),
+            Scheme::Esdirk3 => "esdirk3".to_string(),
         }
     }
 
@@ -93,6 +99,7 @@ impl Scheme {
         match *self {
             Scheme::Hht { alpha } => (1.0 + alpha) / (1.0 - alpha),
             Scheme::GeneralizedAlpha { rho_inf } => rho_inf,
+            Scheme::Esdirk3 => 0.0,
         }
     }
 
@@ -127,6 +134,7 @@ impl Scheme {
                     Some(_) => num("genalpha", "[0, 1]", Scheme::rho_inf_ok)?,
                 },
             }),
+            "esdirk3" if value.is_none() => Ok(Scheme::Esdirk3),
             _ => Err(SchemeNameError::Unknown(s.to_string())),
         }
     }
@@ -151,6 +159,7 @@ impl fmt::Display for Scheme {
             Scheme::GeneralizedAlpha { rho_inf } => {
                 write!(f, "generalized-alpha rho_inf {rho_inf}")
             }
+            Scheme::Esdirk3 => write!(f, "ESDIRK3"),
         }
     }
 }

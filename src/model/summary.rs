@@ -15,7 +15,7 @@ pub struct Effects {
     pub point_masses: bool,
     /// At least one CAME element.
     pub contact: bool,
-    /// A CAME with μ > 0.
+    /// A CAME with μ > 0, or an RSPRING with a friction torque.
     pub friction: bool,
     /// A material with non-zero damping.
     pub material_damping: bool,
@@ -25,6 +25,8 @@ pub struct Effects {
     pub rigid_bodies: bool,
     /// At least one kinematic joint.
     pub joints: bool,
+    /// At least one SPRING, BUSHING or RSPRING (springs and dampers).
+    pub springs: bool,
     /// At least one driver (`DRIVE` on a joint, `PRESCRIBED` element): a motion
     /// prescribed in time, whose work enters the energy balance.
     pub drivers: bool,
@@ -46,6 +48,7 @@ impl Effects {
             (self.flexible_beams, "flexible beams"),
             (self.rigid_bodies, "rigid bodies"),
             (self.joints, "joints"),
+            (self.springs, "springs and dampers"),
             (self.drivers, "drivers"),
             (self.clearances, "clearance joints"),
         ];
@@ -135,6 +138,11 @@ impl Model {
                 | ElementKind::Spherical
                 | ElementKind::Clamp
                 | ElementKind::Prismatic { .. } => e.joints = true,
+                ElementKind::Spring(_) | ElementKind::Bushing(_) => e.springs = true,
+                ElementKind::RSpring(r) => {
+                    e.springs = true;
+                    e.friction |= r.friction > 0.0;
+                }
                 ElementKind::Prescribed { .. } => e.drivers = true,
             }
         }

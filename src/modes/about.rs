@@ -3,7 +3,7 @@
 //! summary and `mecano-rs modes` share.
 
 use super::output::DeckStep;
-use super::{ModalAnalysis, ModesError};
+use super::{ModalAnalysis, ModesError, Solver};
 use crate::model::{Analysis, Model};
 use crate::solver::{self, Integrator, Observer, Snapshot};
 
@@ -111,7 +111,17 @@ pub fn analyse_model(
     about: About,
     count: usize,
 ) -> Result<(Integrator, ModalAnalysis), Failed> {
-    analyse_model_with(model, about, count, true)
+    analyse_model_using(model, about, count, Solver::Auto)
+}
+
+/// [`analyse_model`] with the solver chosen.
+pub fn analyse_model_using(
+    model: &Model,
+    about: About,
+    count: usize,
+    solver: Solver,
+) -> Result<(Integrator, ModalAnalysis), Failed> {
+    analyse_model_with(model, about, count, true, solver)
 }
 
 fn analyse_model_with(
@@ -119,20 +129,23 @@ fn analyse_model_with(
     about: About,
     count: usize,
     warn: bool,
+    solver: Solver,
 ) -> Result<(Integrator, ModalAnalysis), Failed> {
-    let integ = reach_state_with(model, about, warn)?;
+    let mut integ = reach_state_with(model, about, warn)?;
     let groups: Vec<&str> = model.elements.values().map(|e| e.kind.keyword()).collect();
     let a = crate::modes::analyse(
-        &integ.sys,
+        &mut integ.sys,
         &integ.nodes,
         &integ.lambda,
         integ.scale,
         integ.t,
         &groups,
         count,
+        solver,
     )
     .map_err(|e| match e {
         ModesError::Dense(d) => failed(d.to_string()),
+        ModesError::Sparse(d) => failed(d.to_string()),
         other => bad(other.to_string()),
     })?;
     Ok((integ, a))
@@ -162,19 +175,19 @@ pub fn lowest_about_initial(
     warn: bool,
 ) -> Result<ModalAnalysis, Failed> {
     let guess = elastic + 6;
-    let probe = match analyse_model_with(model, About::Initial, guess, warn) {
+    let probe = match analyse_model_with(model, About::Initial, guess, warn, Solver::Dense) {
         Ok((_, mut a)) if a.rigid_modes + elastic <= guess => {
             // Rigid modes come first, then the others by frequency.
             a.modes.truncate(a.rigid_modes + elastic);
             return Ok(a);
         }
         Ok((_, a)) => a,
-        Err(_) => analyse_model_with(model, About::Initial, 1, warn)?.1,
+        Err(_) => analyse_model_with(model, About::Initial, 1, warn, Solver::Dense)?.1,
     };
     // A state-space solve (gyroscopic, damped) finds up to twice the free unknowns'
     // eigenvalues; at most `free_unknowns` modes may be asked for.
     let n = (probe.rigid_modes + elastic)
         .min(probe.finite_modes)
         .min(probe.free_unknowns);
-    Ok(analyse_model_with(model, About::Initial, n, warn)?.1)
+    Ok(analyse_model_with(model, About::Initial, n, warn, Solver::Dense)?.1)
 }

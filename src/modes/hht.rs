@@ -64,6 +64,23 @@ pub fn spectral(scheme: &Scheme, omega_h: f64) -> Spectral {
         Scheme::Hht { .. } | Scheme::GeneralizedAlpha { .. } => {
             principal_of(&amplification(&AlphaParams::of(scheme), omega_h), omega_h)
         }
+        Scheme::Esdirk3 => {
+            // A Runge–Kutta scheme's amplification of the mode is R(iΩ) (module docs of
+            // `solver::integrator::esdirk`), its conjugate pair the mode's other root.
+            let z =
+                crate::solver::integrator::esdirk::stability(nalgebra::Complex::new(0.0, omega_h));
+            let arg = z.im.atan2(z.re);
+            Spectral {
+                omega_h,
+                radius: z.norm(),
+                damping: if arg > 0.0 { -z.norm().ln() / arg } else { 0.0 },
+                period_error: if arg > 0.0 {
+                    omega_h / arg - 1.0
+                } else {
+                    f64::INFINITY
+                },
+            }
+        }
     }
 }
 

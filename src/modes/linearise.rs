@@ -84,7 +84,141 @@ pub fn linearise(
     let mut full_k = DMatrix::<f64>::zeros(n, n);
     let mut c = DMatrix::<f64>::zeros(nn, nn);
     let mut m = DMatrix::<f64>::zeros(nn, nn);
-    let base = EvalContext {
+    let base = base_context(sys, scale, t);
+    let mut locals = Vec::with_capacity(sys.elements.len());
+    for e in 0..sys.elements.len() {
+        let p = element_parts(sys, e, nodes, lambda, &base);
+        let size = p.rows.len();
+        for j in 0..size {
+            for i in 0..size {
+                let (Some(gi), Some(gj)) = (p.rows[i], p.rows[j]) else {
+                    continue;
+                };
+                let q = j * size + i;
+                full_k[(gi, gj)] += p.k[q];
+                if gi < nn && gj < nn {
+                    m[(gi, gj)] += p.m[q];
+                    c[(gi, gj)] += p.c[q];
+                }
+            }
+        }
+        locals.push(p.local_matrices());
+    }
+    // Applied moments: −Rᵀm enters the material equations, its spin derivative −(Rᵀm)~.
+    for (i, j, v) in moment_stiffness(sys, nodes, t) {
+        full_k[(i, j)] += v;
+    }
+    let k = full_k.view((0, 0), (nn, nn)).into_owned();
+    let b = full_k.view((nn, 0), (n - nn, nn)).into_owned() / scale;
+    Linearised { k, c, m, b, locals }
+}
+
+/// One element's linearisation at the state: its equation map (nodal dofs, then its
+/// multipliers; `None` = fixed) and its `K`, `M`, `C` on it (column-major, `size × size`,
+/// `size = rows.len()`; `K`'s multiplier rows and columns hold `s B` and `s Bᵀ`).
+pub struct ElementParts {
+    /// Global equation of each local row.
+    pub rows: Vec<Option<usize>>,
+    /// Local nodal unknowns (`6·nodes`); the multipliers follow.
+    pub nloc: usize,
+    /// `∂r/∂q`.
+    pub k: Vec<f64>,
+    /// `∂r/∂a`.
+    pub m: Vec<f64>,
+    /// `∂r/∂v`.
+    pub c: Vec<f64>,
+}
+
+impl ElementParts {
+    /// The nodal blocks of `K` and `M`, for energy shares.
+    pub fn local_matrices(&self) -> ElementMatrices {
+        let (size, nloc) = (self.rows.len(), self.nloc);
+        let block = |a: &[f64]| -> Vec<f64> {
+            (0..nloc)
+                .flat_map(|j| a[j * size..j * size + nloc].to_vec())
+                .collect()
+        };
+        ElementMatrices {
+            rows: self.rows[..nloc].to_vec(),
+            k: block(&self.k),
+            m: block(&self.m),
+        }
+    }
+}
+
+/// Element `e`'s [`ElementParts`] at the state (`base`: `c_v = c_a = 0`).
+pub fn element_parts(
+    sys: &System,
+    e: usize,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    base: &EvalContext,
+) -> ElementParts {
+    let el = &sys.elements[e];
+    let nm = el.multipliers();
+    let nloc = 6 * el.nodes().len();
+    let size = nloc + nm;
+    let rows: Vec<Option<usize>> = el
+        .nodes()
+        .iter()
+        .flat_map(|&node| sys.node_dofs[node].map(|d| (d != FIXED).then_some(d)))
+        .chain((0..nm).map(|k| Some(sys.mult_offset[e] + k)))
+        .collect();
+    let lam = sys.element_lambda(e, lambda);
+    let eval = |cv: f64, ca: f64| {
+        let mut l = Local::new(size);
+        let ctx = EvalContext {
+            c_v: cv,
+            c_a: ca,
+            ..*base
+        };
+        el.evaluate(&ctx, nodes, lam, true, &mut l);
+        l
+    };
+    // K = S(0, 0); M and C as differences S(0, c) − S(0, 0) over c, with c the
+    // ratio of the element's stiffness to its mass (damping) entries, so that the
+    // difference keeps full precision when K ≫ M (stiff bars). (`Local::rate` holds
+    // only the parts the rotation tangent needs: a point mass's translational mass
+    // is in `tan` alone.)
+    let lk = eval(0.0, 0.0);
+    let kmax = max_abs(&lk.tan);
+    let rate_part = |cv: f64, ca: f64| -> Vec<f64> {
+        let probe = eval(cv, ca);
+        let est = probe
+            .tan
+            .iter()
+            .zip(&lk.tan)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let c = if est > 0.0 {
+            (kmax / est).max(1.0)
+        } else {
+            1.0
+        };
+        let l = if c == 1.0 {
+            probe
+        } else {
+            eval(cv * c, ca * c)
+        };
+        l.tan
+            .iter()
+            .zip(&lk.tan)
+            .map(|(a, b)| (a - b) / c)
+            .collect()
+    };
+    let m = rate_part(0.0, 1.0);
+    let c = rate_part(1.0, 0.0);
+    ElementParts {
+        rows,
+        nloc,
+        k: lk.tan,
+        m,
+        c,
+    }
+}
+
+/// The base context of a linearisation at time `t` (`c_v = c_a = 0`).
+pub fn base_context(sys: &System, scale: f64, t: f64) -> EvalContext {
+    EvalContext {
         t,
         c_v: 0.0,
         c_a: 0.0,
@@ -93,88 +227,13 @@ pub fn linearise(
         constraint_scale: scale,
         penalty: 0.0,
         h: 0.0,
-    };
-    let mut locals = Vec::with_capacity(sys.elements.len());
-    for (e, el) in sys.elements.iter().enumerate() {
-        let nm = el.multipliers();
-        let nloc = 6 * el.nodes().len();
-        let size = nloc + nm;
-        let rows: Vec<Option<usize>> = el
-            .nodes()
-            .iter()
-            .flat_map(|&node| sys.node_dofs[node].map(|d| (d != FIXED).then_some(d)))
-            .chain((0..nm).map(|k| Some(sys.mult_offset[e] + k)))
-            .collect();
-        let lam = sys.element_lambda(e, lambda);
-        let eval = |cv: f64, ca: f64| {
-            let mut l = Local::new(size);
-            let ctx = EvalContext {
-                c_v: cv,
-                c_a: ca,
-                ..base
-            };
-            el.evaluate(&ctx, nodes, lam, true, &mut l);
-            l
-        };
-        // K = S(0, 0); M and C as differences S(0, c) − S(0, 0) over c, with c the
-        // ratio of the element's stiffness to its mass (damping) entries, so that the
-        // difference keeps full precision when K ≫ M (stiff bars). (`Local::rate` holds
-        // only the parts the rotation tangent needs: a point mass's translational mass
-        // is in `tan` alone.)
-        let lk = eval(0.0, 0.0);
-        let kmax = max_abs(&lk.tan);
-        let rate_part = |cv: f64, ca: f64| -> Vec<f64> {
-            let probe = eval(cv, ca);
-            let est = probe
-                .tan
-                .iter()
-                .zip(&lk.tan)
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-            let c = if est > 0.0 {
-                (kmax / est).max(1.0)
-            } else {
-                1.0
-            };
-            let l = if c == 1.0 {
-                probe
-            } else {
-                eval(cv * c, ca * c)
-            };
-            l.tan
-                .iter()
-                .zip(&lk.tan)
-                .map(|(a, b)| (a - b) / c)
-                .collect()
-        };
-        let lm = rate_part(0.0, 1.0);
-        let lc = rate_part(1.0, 0.0);
-        let mut ek = vec![0.0; nloc * nloc];
-        let mut em = vec![0.0; nloc * nloc];
-        for j in 0..size {
-            for i in 0..size {
-                let p = j * size + i;
-                let kv = lk.tan[p];
-                if i < nloc && j < nloc {
-                    ek[j * nloc + i] = kv;
-                    em[j * nloc + i] = lm[p];
-                }
-                let (Some(gi), Some(gj)) = (rows[i], rows[j]) else {
-                    continue;
-                };
-                full_k[(gi, gj)] += kv;
-                if gi < nn && gj < nn {
-                    m[(gi, gj)] += lm[p];
-                    c[(gi, gj)] += lc[p];
-                }
-            }
-        }
-        locals.push(ElementMatrices {
-            rows: rows[..nloc].to_vec(),
-            k: ek,
-            m: em,
-        });
     }
-    // Applied moments: −Rᵀm enters the material equations, its spin derivative −(Rᵀm)~.
+}
+
+/// The follower stiffness `−(Rᵀm)~` of the global applied moments at `t`, as
+/// (spin row, spin column, value) on nodal equations.
+pub fn moment_stiffness(sys: &System, nodes: &[NodeState], t: f64) -> Vec<(usize, usize, f64)> {
+    let mut out = Vec::new();
     for l in sys.loads.iter().filter(|l| l.moment) {
         let mm = nodes[l.node].r.transpose() * l.at(t);
         let kk = -skew(&mm);
@@ -182,14 +241,12 @@ pub fn linearise(
         for a in 0..3 {
             for b in 0..3 {
                 if d[3 + a] != FIXED && d[3 + b] != FIXED {
-                    full_k[(d[3 + a], d[3 + b])] += kk[(a, b)];
+                    out.push((d[3 + a], d[3 + b], kk[(a, b)]));
                 }
             }
         }
     }
-    let k = full_k.view((0, 0), (nn, nn)).into_owned();
-    let b = full_k.view((nn, 0), (n - nn, nn)).into_owned() / scale;
-    Linearised { k, c, m, b, locals }
+    out
 }
 
 /// Relative threshold on the singular values of the (row-equilibrated) constraint

@@ -17,10 +17,12 @@ pub mod hht;
 pub mod linearise;
 pub mod output;
 pub mod run_summary;
+pub mod sparse;
+pub mod vtk;
 
 use crate::elements::NodeState;
 use crate::solver::system::System;
-use linearise::Linearised;
+use linearise::ElementMatrices;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
@@ -72,6 +74,8 @@ pub enum Method {
     Symmetric,
     /// Quadratic problem in first-order form (damped, gyroscopic or non-symmetric).
     StateSpace,
+    /// Symmetric problem by sparse shift-invert block Lanczos ([`sparse`]).
+    SparseSymmetric,
 }
 
 /// The result of a modal analysis.
@@ -118,13 +122,37 @@ pub enum ModesError {
     /// The dense solve failed.
     #[error(transparent)]
     Dense(#[from] dense::DenseError),
+    /// The sparse solve failed.
+    #[error(transparent)]
+    Sparse(#[from] sparse::SparseError),
+}
+
+/// Nodal unknowns from which [`analyse`] takes the sparse solver ([`sparse`]) for a
+/// conservative model: measured crossing of the two paths' times (docs/modes.md).
+pub const SPARSE_MIN_UNKNOWNS: usize = 600;
+/// Above this many nodal unknowns a model the sparse solver refuses (damped, gyroscopic,
+/// redundant constraints) is not solved densely either: `O(n³)` flops and `n²` memory
+/// (3000 unknowns: minutes).
+pub const DENSE_MAX_UNKNOWNS: usize = 3000;
+
+/// Which solver [`analyse`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solver {
+    /// Sparse from [`SPARSE_MIN_UNKNOWNS`] when `count` is at most a quarter of the
+    /// unknowns, dense otherwise (and dense when the sparse one refuses the model, up to
+    /// [`DENSE_MAX_UNKNOWNS`]).
+    Auto,
+    /// Always dense.
+    Dense,
+    /// Always sparse.
+    Sparse,
 }
 
 /// Relative size of `C` (against `√(‖K‖‖M‖)`) below which the model is undamped and not
 /// gyroscopic: round-off of assembled zeros is ~ε; 1e-10 keeps a real dashpot or spin.
-const DAMPED_TOL: f64 = 1e-10;
+pub(crate) const DAMPED_TOL: f64 = 1e-10;
 /// Relative asymmetry of `K` above which the symmetric problem is not used.
-const ASYMMETRY_TOL: f64 = 1e-8;
+pub(crate) const ASYMMETRY_TOL: f64 = 1e-8;
 
 fn max_abs(a: &DMatrix<f64>) -> f64 {
     a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
@@ -132,7 +160,105 @@ fn max_abs(a: &DMatrix<f64>) -> f64 {
 
 /// The lowest `count` modes of `sys` linearised at the state (`nodes`, scaled multipliers
 /// `lambda`, constraint scale `scale`, time `t`); `groups[e]` names element `e`'s group.
+/// `solver` chooses dense or sparse ([`Solver`]); the sparse path overwrites `sys`'s
+/// iteration matrix.
+#[allow(clippy::too_many_arguments)]
 pub fn analyse(
+    sys: &mut System,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+    groups: &[&str],
+    count: usize,
+    solver: Solver,
+) -> Result<ModalAnalysis, ModesError> {
+    let nn = sys.n_node_eq;
+    let sparse = match solver {
+        Solver::Dense => false,
+        Solver::Sparse => true,
+        Solver::Auto => nn >= SPARSE_MIN_UNKNOWNS && 4 * count <= nn,
+    };
+    if sparse {
+        match analyse_sparse(sys, nodes, lambda, scale, t, groups, count) {
+            Err(ModesError::Sparse(e))
+                if solver == Solver::Auto
+                    && nn <= DENSE_MAX_UNKNOWNS
+                    && !matches!(e, sparse::SparseError::NoConvergence { .. }) => {}
+            r => return r,
+        }
+    }
+    analyse_dense(sys, nodes, lambda, scale, t, groups, count)
+}
+
+fn group_index(groups: &[&str]) -> (Vec<String>, Vec<usize>) {
+    let mut group_names: Vec<String> = Vec::new();
+    let group_of: Vec<usize> = groups
+        .iter()
+        .map(|g| match group_names.iter().position(|n| n == g) {
+            Some(i) => i,
+            None => {
+                group_names.push(g.to_string());
+                group_names.len() - 1
+            }
+        })
+        .collect();
+    (group_names, group_of)
+}
+
+/// [`analyse`] by the sparse solver. What it cannot know without the whole spectrum is
+/// stated, not guessed: `rigid_modes` counts the zeros among the modes found,
+/// `finite_modes` is the free unknowns (an upper bound) and `highest_hz` is NaN (null in
+/// `summary.json`).
+fn analyse_sparse(
+    sys: &mut System,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+    groups: &[&str],
+    count: usize,
+) -> Result<ModalAnalysis, ModesError> {
+    let free = sys.n_node_eq.saturating_sub(sys.n_eq() - sys.n_node_eq);
+    if free == 0 {
+        return Err(ModesError::NothingToVibrate(
+            "every degree of freedom is fixed or constrained".into(),
+        ));
+    }
+    if count > free {
+        return Err(ModesError::TooMany {
+            count,
+            free,
+            finite: free,
+        });
+    }
+    let found = sparse::lowest(sys, nodes, lambda, scale, t, count)?;
+    let (group_names, group_of) = group_index(groups);
+    let ng = group_names.len();
+    let is_zero = |w2: f64| w2.abs() <= found.zero;
+    let mut pairs: Vec<&(f64, Vec<f64>)> = found.pairs.iter().collect();
+    pairs.sort_by_key(|p| u8::from(!is_zero(p.0)));
+    let modes = pairs
+        .into_iter()
+        .map(|(w2, phi)| {
+            let z = is_zero(*w2);
+            make_mode(phi.clone(), *w2, z, &found.locals, &group_of, ng)
+        })
+        .collect();
+    Ok(ModalAnalysis {
+        modes,
+        free_unknowns: found.free_unknowns,
+        constraints: (found.constraints, found.constraints),
+        rigid_modes: found.pairs.iter().filter(|p| is_zero(p.0)).count(),
+        finite_modes: found.free_unknowns,
+        highest_hz: f64::NAN,
+        method: Method::SparseSymmetric,
+        asymmetry: found.asymmetry,
+        groups: group_names,
+    })
+}
+
+fn analyse_dense(
     sys: &System,
     nodes: &[NodeState],
     lambda: &[f64],
@@ -202,21 +328,22 @@ pub fn analyse(
     // Rigid first, unstable next, then by ω².
     let mut order: Vec<&dense::RawMode> = raw.iter().collect();
     order.sort_by_key(|r| u8::from(!is_zero(r)));
-    let mut group_names: Vec<String> = Vec::new();
-    let group_of: Vec<usize> = groups
-        .iter()
-        .map(|g| match group_names.iter().position(|n| n == g) {
-            Some(i) => i,
-            None => {
-                group_names.push(g.to_string());
-                group_names.len() - 1
-            }
-        })
-        .collect();
+    let (group_names, group_of) = group_index(groups);
     let modes = order
         .into_iter()
         .take(count)
-        .map(|r| make_mode(r, is_zero(r), &basis, &lin, &group_of, group_names.len()))
+        .map(|r| {
+            let phi: DVector<f64> = &basis * &r.shape;
+            let phi = phi.iter().copied().collect();
+            make_mode_s(
+                phi,
+                r.s,
+                is_zero(r),
+                &lin.locals,
+                &group_of,
+                group_names.len(),
+            )
+        })
         .collect();
     Ok(ModalAnalysis {
         modes,
@@ -231,18 +358,33 @@ pub fn analyse(
     })
 }
 
+/// A conservative mode of `ω² = w2` ([`make_mode_s`] with `s = iω`, or `+√(−ω²)`).
 fn make_mode(
-    r: &dense::RawMode,
+    shape: Vec<f64>,
+    w2: f64,
     zero: bool,
-    basis: &DMatrix<f64>,
-    lin: &Linearised,
+    locals: &[ElementMatrices],
     group_of: &[usize],
     ngroups: usize,
 ) -> Mode {
-    let phi: DVector<f64> = basis * &r.shape;
-    let shape: Vec<f64> = phi.iter().copied().collect();
+    let s = if w2 >= 0.0 {
+        (0.0, w2.sqrt())
+    } else {
+        ((-w2).sqrt(), 0.0)
+    };
+    make_mode_s(shape, s, zero, locals, group_of, ngroups)
+}
+
+fn make_mode_s(
+    shape: Vec<f64>,
+    s: (f64, f64),
+    zero: bool,
+    locals: &[ElementMatrices],
+    group_of: &[usize],
+    ngroups: usize,
+) -> Mode {
     let (mut kin, mut strain) = (vec![0.0; ngroups], vec![0.0; ngroups]);
-    for (e, el) in lin.locals.iter().enumerate() {
+    for (e, el) in locals.iter().enumerate() {
         let g = group_of.get(e).copied().unwrap_or(0);
         if g < ngroups {
             kin[g] += el.quadratic(&el.m, &shape);
@@ -259,7 +401,7 @@ fn make_mode(
     };
     share(&mut kin);
     share(&mut strain);
-    let (re, im) = if zero { (0.0, 0.0) } else { r.s };
+    let (re, im) = if zero { (0.0, 0.0) } else { s };
     let w = re.hypot(im);
     let kind = if zero {
         ModeKind::Rigid

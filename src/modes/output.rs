@@ -5,6 +5,7 @@
 
 use super::hht::{self, Resolution};
 use super::{ModalAnalysis, Mode};
+use crate::elements::NodeState;
 use crate::solver::system::{FIXED, System};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -79,9 +80,14 @@ fn node_shape(sys: &System, m: &Mode, node: usize) -> [f64; 6] {
 
 /// `modes_shapes.csv`'s text: the shapes at dense nodes `nodes`, each mode scaled so that
 /// its largest translation over all nodes is +1 (its largest rotation when it has no
-/// translation).
-pub fn shapes_csv(a: &ModalAnalysis, sys: &System, nodes: &[usize]) -> String {
-    let mut s = String::from("mode,node,ux,uy,uz,rx,ry,rz\n");
+/// translation), and the nodes' positions `x, y, z` at the state (`states`).
+pub fn shapes_csv(
+    a: &ModalAnalysis,
+    sys: &System,
+    nodes: &[usize],
+    states: &[NodeState],
+) -> String {
+    let mut s = String::from("mode,node,ux,uy,uz,rx,ry,rz,x,y,z\n");
     for (i, m) in a.modes.iter().enumerate() {
         let all: Vec<[f64; 6]> = (0..sys.node_ids.len())
             .map(|n| node_shape(sys, m, n))
@@ -102,6 +108,9 @@ pub fn shapes_csv(a: &ModalAnalysis, sys: &System, nodes: &[usize]) -> String {
             let _ = write!(s, "{},{}", i + 1, sys.node_ids[n].0);
             for c in v {
                 let _ = write!(s, ",{}", num(c * scale));
+            }
+            for c in states[n].x.iter() {
+                let _ = write!(s, ",{}", num(*c));
             }
             s.push('\n');
         }
@@ -167,10 +176,11 @@ pub fn write_all(
     a: &ModalAnalysis,
     sys: &System,
     nodes: &[usize],
+    states: &[NodeState],
     summary: &serde_json::Value,
 ) -> std::io::Result<()> {
     let csv = modes_csv(a);
-    let shapes = shapes_csv(a, sys, nodes);
+    let shapes = shapes_csv(a, sys, nodes, states);
     let json = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join("modes.csv"), csv)?;

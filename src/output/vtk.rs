@@ -55,19 +55,7 @@ impl VtkWriter {
 
     fn create_in(dir: &Path, model: &Model, _sys: &System) -> io::Result<Self> {
         fs::create_dir_all(dir.join("vtk"))?;
-        let mut cells = Vec::new();
-        for el in model.elements.values() {
-            if matches!(el.kind, ElementKind::Beam { .. } | ElementKind::Rigid) {
-                let idx: Vec<usize> = el
-                    .nodes
-                    .iter()
-                    .filter_map(|n| model.nodes.get_index_of(n))
-                    .collect();
-                for w in idx.windows(2) {
-                    cells.push((el.id.0, w[0], w[1]));
-                }
-            }
-        }
+        let cells = line_cells(model);
         let w = VtkWriter {
             dir: dir.to_path_buf(),
             sampling: super::Sampling::of(model),
@@ -98,67 +86,7 @@ impl VtkWriter {
             vel.push(s.v);
             omega.push(s.r * s.w);
         }
-        let all = [&pts, &disp, &rot, &vel, &omega];
-        if all
-            .iter()
-            .any(|a| a.iter().any(|v| !v.iter().all(|c| c.is_finite())))
-        {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                "refusing to write a non-finite value (VTK frame)",
-            ));
-        }
-        let vecs = |s: &mut String, name: Option<&str>, v: &[nalgebra::Vector3<f64>]| {
-            match name {
-                Some(nm) => {
-                    let _ = writeln!(
-                        s,
-                        "        <DataArray type=\"Float64\" Name=\"{nm}\" NumberOfComponents=\"3\" format=\"ascii\">"
-                    );
-                }
-                None => {
-                    let _ = writeln!(
-                        s,
-                        "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
-                    );
-                }
-            }
-            for p in v {
-                let _ = writeln!(s, "          {:e} {:e} {:e}", p.x, p.y, p.z);
-            }
-            s.push_str("        </DataArray>\n");
-        };
-        let mut s = String::with_capacity(4096 + 200 * n);
-        s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <UnstructuredGrid>\n");
-        let _ = writeln!(
-            s,
-            "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">",
-            self.cells.len()
-        );
-        s.push_str("      <PointData Vectors=\"displacement\">\n");
-        vecs(&mut s, Some("displacement"), &disp);
-        vecs(&mut s, Some("rotation"), &rot);
-        vecs(&mut s, Some("velocity"), &vel);
-        vecs(&mut s, Some("angular_velocity"), &omega);
-        s.push_str("      </PointData>\n      <CellData Scalars=\"element\">\n        <DataArray type=\"Int32\" Name=\"element\" format=\"ascii\">\n         ");
-        for c in &self.cells {
-            let _ = write!(s, " {}", c.0);
-        }
-        s.push_str("\n        </DataArray>\n      </CellData>\n      <Points>\n");
-        vecs(&mut s, None, &pts);
-        s.push_str("      </Points>\n      <Cells>\n        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n         ");
-        for c in &self.cells {
-            let _ = write!(s, " {} {}", c.1, c.2);
-        }
-        s.push_str("\n        </DataArray>\n        <DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n         ");
-        for k in 0..self.cells.len() {
-            let _ = write!(s, " {}", 2 * (k + 1));
-        }
-        s.push_str("\n        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n         ");
-        for _ in &self.cells {
-            let _ = write!(s, " {VTK_LINE}");
-        }
-        s.push_str("\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
+        let s = frame_xml(&self.cells, [&pts, &disp, &rot, &vel, &omega])?;
         let rel = format!("vtk/frame_{:06}.vtu", self.frames.len());
         fs::write(self.dir.join(&rel), s)?;
         self.frames.push((integ.t, rel));
@@ -170,19 +98,7 @@ impl VtkWriter {
     }
 
     fn write_pvd(&self) -> io::Result<()> {
-        let mut s = String::from(
-            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
-        );
-        for (t, f) in &self.frames {
-            let _ = writeln!(
-                s,
-                "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{f}\"/>"
-            );
-        }
-        s.push_str("  </Collection>\n</VTKFile>\n");
-        let tmp = self.dir.join(format!("{PVD_NAME}.tmp"));
-        fs::write(&tmp, s)?;
-        fs::rename(tmp, self.dir.join(PVD_NAME))
+        write_collection(&self.dir.join(PVD_NAME), &self.frames)
     }
 
     /// The state a restart needs: the frames written so far (the `.pvd` is rewritten
@@ -229,6 +145,116 @@ impl Observer for VtkWriter {
         }
         Ok(())
     }
+}
+
+/// The line cells of a model: (element number, dense node 1, dense node 2) for each
+/// segment of its beams and rigid bodies.
+pub fn line_cells(model: &Model) -> Vec<(u32, usize, usize)> {
+    let mut cells = Vec::new();
+    for el in model.elements.values() {
+        if matches!(el.kind, ElementKind::Beam { .. } | ElementKind::Rigid) {
+            let idx: Vec<usize> = el
+                .nodes
+                .iter()
+                .filter_map(|n| model.nodes.get_index_of(n))
+                .collect();
+            for w in idx.windows(2) {
+                cells.push((el.id.0, w[0], w[1]));
+            }
+        }
+    }
+    cells
+}
+
+/// One `.vtu` frame's text: points `all[0]` and point data `displacement`, `rotation`,
+/// `velocity`, `angular_velocity` (`all[1..]`), the line `cells`. Refuses a non-finite value.
+pub fn frame_xml(
+    cells: &[(u32, usize, usize)],
+    all: [&[nalgebra::Vector3<f64>]; 5],
+) -> io::Result<String> {
+    let [pts, disp, rot, vel, omega] = all;
+    if all
+        .iter()
+        .any(|a| a.iter().any(|v| !v.iter().all(|c| c.is_finite())))
+    {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            "refusing to write a non-finite value (VTK frame)",
+        ));
+    }
+    let vecs = |s: &mut String, name: Option<&str>, v: &[nalgebra::Vector3<f64>]| {
+        match name {
+            Some(nm) => {
+                let _ = writeln!(
+                    s,
+                    "        <DataArray type=\"Float64\" Name=\"{nm}\" NumberOfComponents=\"3\" format=\"ascii\">"
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+                );
+            }
+        }
+        for p in v {
+            let _ = writeln!(s, "          {:e} {:e} {:e}", p.x, p.y, p.z);
+        }
+        s.push_str("        </DataArray>\n");
+    };
+    let n = pts.len();
+    let mut s = String::with_capacity(4096 + 200 * n);
+    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <UnstructuredGrid>\n");
+    let _ = writeln!(
+        s,
+        "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">",
+        cells.len()
+    );
+    s.push_str("      <PointData Vectors=\"displacement\">\n");
+    vecs(&mut s, Some("displacement"), &disp);
+    vecs(&mut s, Some("rotation"), &rot);
+    vecs(&mut s, Some("velocity"), &vel);
+    vecs(&mut s, Some("angular_velocity"), &omega);
+    s.push_str("      </PointData>\n      <CellData Scalars=\"element\">\n        <DataArray type=\"Int32\" Name=\"element\" format=\"ascii\">\n         ");
+    for c in cells {
+        let _ = write!(s, " {}", c.0);
+    }
+    s.push_str("\n        </DataArray>\n      </CellData>\n      <Points>\n");
+    vecs(&mut s, None, &pts);
+    s.push_str("      </Points>\n      <Cells>\n        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n         ");
+    for c in cells {
+        let _ = write!(s, " {} {}", c.1, c.2);
+    }
+    s.push_str("\n        </DataArray>\n        <DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n         ");
+    for k in 0..cells.len() {
+        let _ = write!(s, " {}", 2 * (k + 1));
+    }
+    s.push_str("\n        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n         ");
+    for _ in cells {
+        let _ = write!(s, " {VTK_LINE}");
+    }
+    s.push_str(
+        "\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
+    );
+    Ok(s)
+}
+
+/// Writes a `.pvd` collection of `frames` (time, file relative to the collection's
+/// directory) atomically (a temporary file renamed).
+pub fn write_collection(path: &Path, frames: &[(f64, String)]) -> io::Result<()> {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    );
+    for (t, f) in frames {
+        let _ = writeln!(
+            s,
+            "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{f}\"/>"
+        );
+    }
+    s.push_str("  </Collection>\n</VTKFile>\n");
+    let tmp = path.with_extension("pvd.tmp");
+    fs::write(&tmp, s)?;
+    fs::rename(tmp, path)
 }
 
 /// Forwards every state and progress report to several observers, in order (the first

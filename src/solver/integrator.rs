@@ -101,6 +101,9 @@ impl AlphaParams {
         match *scheme {
             Scheme::Hht { alpha } => AlphaParams::new(alpha),
             Scheme::GeneralizedAlpha { rho_inf } => AlphaParams::generalized(rho_inf),
+            // Not an α scheme: the trapezoidal rule's coefficients stand for the queries that
+            // assume one (a bench's `step_context`, the adaptive steps' error measure).
+            Scheme::Esdirk3 => AlphaParams::new(0.0),
         }
     }
 
@@ -175,6 +178,9 @@ pub struct Integrator {
     /// Newton residual history of the step under way (kept between steps so that a
     /// successful step allocates nothing; handed to the [`Failure`] of a failed one).
     history: Vec<f64>,
+    /// The stages of the ESDIRK scheme when it replaces HHT (`model::Scheme::Esdirk3`);
+    /// `None` = HHT. Scratch within a step: nothing in it is read across steps.
+    esdirk: Option<Box<esdirk::Stages>>,
     /// Buffers of [`Integrator::consistent_accelerations`], kept so that the restarts of
     /// the accelerations at a contact's events allocate nothing (issue 27 §1d).
     acc: AccelerationScratch,
@@ -231,6 +237,8 @@ impl Integrator {
         let nodes: Vec<NodeState> = sys.x0.iter().map(|x| NodeState::at_rest(*x)).collect();
         let n = sys.n_eq();
         let nn = nodes.len();
+        let esdirk =
+            (dynamic && scheme == Scheme::Esdirk3).then(|| Box::new(esdirk::Stages::sized(nn)));
         Integrator {
             lu_step: f64::NAN,
             trial: nodes.clone(),
@@ -244,6 +252,7 @@ impl Integrator {
             tmap: vec![nalgebra::Matrix3::identity(); nn],
             history: Vec::with_capacity(newton.max_iterations as usize + 1),
             acc: AccelerationScratch::sized(n, n - sys.n_node_eq, nn),
+            esdirk,
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -345,7 +354,20 @@ impl Integrator {
     }
 }
 
+/// `nodes` moved along their velocities for a time `dt` (the geodesic `q exp(dt v)`:
+/// `x + v dt`, `R exp(dt Ω̃)`), into `out`: the points of the central differences of `Φ`
+/// along `v` (the restart's `Ḃv`, the ESDIRK stages' `B v`).
+fn moved_along_velocities(nodes: &[NodeState], dt: f64, out: &mut Vec<NodeState>) {
+    out.clear();
+    out.extend(nodes.iter().map(|s| NodeState {
+        x: s.x + s.v * dt,
+        r: s.r * rotation::exp(&(s.w * dt)),
+        ..*s
+    }));
+}
+
 mod error;
+pub mod esdirk;
 mod hht;
 mod newton;
 mod start;

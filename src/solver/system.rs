@@ -267,12 +267,13 @@ impl System {
             (hi - lo).norm().max(1e-6)
         };
         let mut ref_force: f64 = 0.0;
+        // The span the loads' functions are evaluated over (static: the load steps' t ≤ 1).
+        let t_end = match &model.analysis {
+            crate::model::Analysis::Dynamic { end, .. } => *end,
+            crate::model::Analysis::Static { .. } => 1.0,
+        };
         for l in &loads {
-            let fmax = l.function.as_ref().map_or(1.0, |f| match f {
-                Function::Constant(c) => c.abs(),
-                Function::Haversine { .. } => 1.0,
-                Function::Table(p) => p.iter().fold(0.0f64, |m, q| m.max(q.1.abs())),
-            });
+            let fmax = l.function.as_ref().map_or(1.0, |f| f.max_abs(0.0, t_end));
             let scale = if l.moment { 1.0 / ref_length } else { 1.0 };
             ref_force = ref_force.max(safe_norm(&l.value) * fmax * scale);
         }

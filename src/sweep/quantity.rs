@@ -20,6 +20,11 @@
 //! element = 23
 //! summary = "impacts"   # element: impacts | max_penetration | dissipated_energy
 //!                       # run:     energy_error | steps | cpu
+//!
+//! [[quantity]]
+//! name = "f1"
+//! mode = 1              # a deck of ANALYSIS MODES n: its summary.json's mode 1
+//! summary = "frequency" # frequency (natural, Hz) | damped_frequency (Hz) | damping (ratio)
 //! ```
 //!
 //! Histories are those the run wrote (`OUTPUT ... EVERY n`): a deck meant for a sweep
@@ -48,6 +53,7 @@ pub(crate) struct QuantitySpec {
     at: Option<f64>,
     threshold: Option<f64>,
     summary: Option<String>,
+    mode: Option<u32>,
 }
 
 /// Which history file.
@@ -93,6 +99,25 @@ pub enum SummaryKey {
     Steps,
     /// CPU seconds of the run (a timing).
     Cpu,
+    /// A number of mode `mode` (from 1) of a modal analysis's summary.json (a deck of
+    /// `ANALYSIS MODES n`): over a parameter, a Campbell diagram.
+    Mode {
+        /// Mode number, from 1 (rigid modes first, then by frequency).
+        mode: u32,
+        /// Which number.
+        field: ModeField,
+    },
+}
+
+/// What a [`SummaryKey::Mode`] quantity takes of its mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModeField {
+    /// Undamped natural frequency `|s|/2π`, Hz (`natural_hz`).
+    Frequency,
+    /// Damped frequency `Im s/2π`, Hz (`frequency_hz`).
+    DampedFrequency,
+    /// Damping ratio `−Re s/|s|` (`damping_ratio`).
+    Damping,
 }
 
 /// How a quantity is computed.
@@ -149,6 +174,27 @@ impl Quantity {
                 Some(Source::Element(e)) => Some(e),
                 _ => None,
             };
+            if let Some(mode) = q.mode {
+                let field = match s.as_str() {
+                    "frequency" => ModeField::Frequency,
+                    "damped_frequency" => ModeField::DampedFrequency,
+                    "damping" => ModeField::Damping,
+                    _ => {
+                        return Err(format!(
+                            "{ctx}: a `mode` quantity takes summary = \"frequency\", \"damped_frequency\" or \"damping\", not \"{s}\""
+                        ));
+                    }
+                };
+                if mode == 0 || source.is_some() {
+                    return Err(format!(
+                        "{ctx}: `mode` counts from 1 and takes no node or element"
+                    ));
+                }
+                return Ok(Quantity {
+                    name: q.name.clone(),
+                    kind: Kind::Summary(SummaryKey::Mode { mode, field }),
+                });
+            }
             let key = match (s.as_str(), el) {
                 ("impacts", Some(e)) => SummaryKey::Impacts(e),
                 ("max_penetration", Some(e)) => SummaryKey::MaxPenetration(e),
@@ -169,6 +215,11 @@ impl Quantity {
                 name: q.name.clone(),
                 kind: Kind::Summary(key),
             });
+        }
+        if q.mode.is_some() {
+            return Err(format!(
+                "{ctx}: `mode` needs summary = \"frequency\", \"damped_frequency\" or \"damping\""
+            ));
         }
         let source = source.ok_or(format!(
             "{ctx}: needs `node` or `element` (and `column`), or `summary`"
@@ -235,6 +286,20 @@ impl Quantity {
                     SummaryKey::EnergyError => summary["energy"]["max_balance_error"].as_f64(),
                     SummaryKey::Steps => summary["stats"]["steps"].as_f64(),
                     SummaryKey::Cpu => summary["stats"]["cpu_seconds"].as_f64(),
+                    SummaryKey::Mode { mode, field } => {
+                        if summary["modes"].as_array().is_none() {
+                            return Err(format!(
+                                "{}: summary.json has no modes (the deck needs ANALYSIS MODES n)",
+                                self.name
+                            ));
+                        }
+                        let key = match field {
+                            ModeField::Frequency => "natural_hz",
+                            ModeField::DampedFrequency => "frequency_hz",
+                            ModeField::Damping => "damping_ratio",
+                        };
+                        summary["modes"][*mode as usize - 1][key].as_f64()
+                    }
                 };
                 match (key, v) {
                     (

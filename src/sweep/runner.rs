@@ -200,6 +200,21 @@ fn run_fresh(
     let text = std::fs::read_to_string(&plan.deck).unwrap_or_default();
     let result = match crate::deck::load_deck_with(&plan.deck, &overrides) {
         Err(errs) => Err((app::EXIT_BAD_INPUT, deck_errors_text(&errs))),
+        // `ANALYSIS MODES n`: the case is a modal analysis (its summary.json holds the
+        // modes the `mode` quantities read), as `mecano-rs DECK` makes it.
+        Ok(model) if model.modes.is_some() => {
+            let n = model.modes.unwrap_or(1) as usize;
+            let about = app::modes::About::Initial;
+            match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true) {
+                app::EXIT_OK => Ok(crate::solver::RunReport {
+                    stats: Default::default(),
+                    time: 0.0,
+                    failure: None,
+                    interrupted: None,
+                }),
+                code => Err((code, "the modal analysis failed (see its message)".into())),
+            }
+        }
         Ok(model) => {
             // A case writes every accepted step (EVERY 1, the default) so that its
             // quantities see the impacts, which a plain run's grid rows can step over

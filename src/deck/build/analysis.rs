@@ -130,8 +130,8 @@ impl Builder<'_> {
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
-                "ALPHA", "GENALPHA", "RHOINF", "STEP", "END", "MINSTEP", "MAXSTEP", "ADAPTIVE",
-                "TOLPOS", "TOLROT", "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
+                "ALPHA", "GENALPHA", "RHOINF", "ESDIRK3", "STEP", "END", "MINSTEP", "MAXSTEP",
+                "ADAPTIVE", "TOLPOS", "TOLROT", "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
             ]
         } else {
             &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
@@ -144,6 +144,7 @@ impl Builder<'_> {
         let (mut step, mut end, mut min, mut max) = (None, None, None, None);
         let (mut tolpos, mut tolrot, mut growth, mut steps) = (None, None, 2.0, 1);
         let mut adaptive = None;
+        let mut esdirk = None;
         let pos = |v: f64| v > 0.0;
         while let Some(t) = c.peek() {
             let Some((kw, ks)) = c.keyword(kws) else {
@@ -167,6 +168,7 @@ impl Builder<'_> {
                 "MINSTEP" => min = Some(c.number("MINSTEP (smallest step)")?),
                 "MAXSTEP" => max = Some(c.number("MAXSTEP (largest step)")?),
                 "ADAPTIVE" => adaptive = Some(ks),
+                "ESDIRK3" => esdirk = Some(ks),
                 "TOLPOS" => tolpos = Some(c.number_in("TOLPOS", "> 0 m", pos)?),
                 "TOLROT" => tolrot = Some(c.number_in("TOLROT", "> 0 rad", pos)?),
                 "GROWTH" => growth = c.number_in("GROWTH", ">= 1", |v| v >= 1.0)?,
@@ -247,6 +249,13 @@ impl Builder<'_> {
                 }
             };
             let scheme = match genalpha {
+                _ if esdirk.is_some() && seen.has("ALPHA") => {
+                    return Err(conflict("ALPHA", "ESDIRK3", &c.ctx, esdirk.unwrap()));
+                }
+                Some(gs) if esdirk.is_some() => {
+                    return Err(conflict("GENALPHA", "ESDIRK3", &c.ctx, gs));
+                }
+                None if esdirk.is_some() && !seen.has("RHOINF") => Scheme::Esdirk3,
                 Some(gs) if seen.has("ALPHA") => {
                     return Err(conflict("ALPHA", "GENALPHA", &c.ctx, gs));
                 }

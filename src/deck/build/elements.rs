@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 11] = [
+        const TYPES: [&str; 14] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -39,6 +39,9 @@ impl Builder<'_> {
             "PRISMATIC",
             "RIGID",
             "CAME",
+            "SPRING",
+            "BUSHING",
+            "RSPRING",
             "PRESCRIBED",
             "CLEARANCE",
         ];
@@ -239,6 +242,9 @@ impl Builder<'_> {
                 }
                 (ns, ElementKind::Rigid)
             }
+            "SPRING" => self.spring_card(&mut c, id)?,
+            "BUSHING" => Self::bushing_card(&mut c)?,
+            "RSPRING" => self.rspring_card(&mut c, id)?,
             "PRESCRIBED" => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)

@@ -7,9 +7,11 @@ mod clearance;
 mod cursor;
 mod drives;
 mod elements;
+mod functions;
 mod nodes;
 mod properties;
 mod section;
+mod springs;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
@@ -57,8 +59,12 @@ struct Builder<'s> {
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
+    /// RSPRING elements' hinges (element, hinge number, its span), resolved after ELEMENTS.
+    hinge_refs: Vec<(ElementId, u32, Span)>,
     /// Driven joints (`DRIVE` on a HINGE or PRISMATIC card).
     drives: IndexMap<ElementId, crate::model::Drive>,
+    /// The parameters in force (for the expressions of `t` of EXPR functions).
+    parameters: IndexMap<String, f64>,
 }
 
 impl<'s> Builder<'s> {
@@ -147,7 +153,9 @@ pub(crate) fn build_model(
         modes: None,
         output: None,
         divide: Vec::new(),
+        hinge_refs: Vec::new(),
         drives: IndexMap::new(),
+        parameters,
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -180,6 +188,7 @@ pub(crate) fn build_model(
         let r = b.element(c);
         b.push(r);
     }
+    b.resolve_hinges();
     for c in of(Section::Loads) {
         let r = b.load(c);
         b.push(r);
@@ -210,6 +219,7 @@ pub(crate) fn build_model(
         }
         return Err(b.errors);
     };
+    b.check_functions(&analysis);
     if !b.errors.is_empty() {
         return Err(b.errors);
     }
@@ -227,7 +237,7 @@ pub(crate) fn build_model(
         modes: b.modes,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
-        parameters,
+        parameters: b.parameters,
         order_nodes: IndexMap::new(),
         drives: b.drives,
     };

@@ -1,4 +1,4 @@
-//! Stage 2, definitions: TITLE, MATERIALS, SECTIONS, FUNCTIONS.
+//! Stage 2, definitions: TITLE, MATERIALS, SECTIONS (FUNCTIONS: `functions.rs`).
 
 use super::cursor::*;
 use super::section::section_properties;
@@ -176,62 +176,6 @@ impl Builder<'_> {
             shear_factor: k,
         };
         self.add_section(id, id_span, SectionData::Geometry(geometry), rigid, span);
-        Ok(())
-    }
-
-    // ---------------------------------------------------------------- FUNCTIONS
-    pub(super) fn function(&mut self, card: &Card<'_>) -> R<()> {
-        let span = card.span();
-        let mut c = Cursor::new(card, "FUNCTIONS card");
-        let (id, id_span) = c.uint("function number")?;
-        c.ctx = format!("function {id}");
-        let (kw, _) = c.expect_keyword(
-            &["TABLE", "CONSTANT", "HAVERSINE"],
-            "TABLE, CONSTANT or HAVERSINE",
-        )?;
-        let function = if kw == "CONSTANT" {
-            let (v, _, _) = c.number("the constant value")?;
-            c.finish()?;
-            Function::Constant(v)
-        } else if kw == "HAVERSINE" {
-            let (start, _, _) = c.number("the pulse's start time")?;
-            let duration = c.number_in("the pulse's duration", "> 0 s", |v| v > 0.0)?;
-            c.finish()?;
-            Function::Haversine { start, duration }
-        } else {
-            let mut vals = Vec::new();
-            while c.peek().is_some() {
-                vals.push(c.number("a table value (t or f)")?);
-            }
-            if vals.is_empty() || vals.len() % 2 == 1 {
-                return Err(DeckError::new(K::OddTable { count: vals.len() }, span));
-            }
-            for w in vals.chunks(2).collect::<Vec<_>>().windows(2) {
-                let (prev, cur) = (w[0][0], w[1][0]);
-                if cur.0 < prev.0 {
-                    return Err(DeckError::new(
-                        K::DecreasingTime {
-                            found: cur.2.to_string(),
-                            previous: prev.2.to_string(),
-                        },
-                        cur.1,
-                    ));
-                }
-            }
-            Function::Table(vals.chunks(2).map(|p| (p[0].0, p[1].0)).collect())
-        };
-        if let Some(first) = self.functions.get(&FunctionId(id)).map(|f| f.span) {
-            self.duplicate("function", id, first, id_span);
-            return Ok(());
-        }
-        self.functions.insert(
-            FunctionId(id),
-            FunctionDef {
-                id: FunctionId(id),
-                function,
-                span,
-            },
-        );
         Ok(())
     }
 }

@@ -78,6 +78,9 @@ impl Integrator {
     /// load factor `t + h` in statics). On success the state advances; on failure it is
     /// left unchanged and a diagnosis is returned.
     pub fn try_step(&mut self, h: f64) -> Result<StepInfo, Failure> {
+        if self.dynamic && self.esdirk.is_some() {
+            return self.try_esdirk_step(h);
+        }
         let t1 = self.t + h;
         let p = self.params;
         // Rescale multipliers to this step's constraint scale.
@@ -110,6 +113,23 @@ impl Integrator {
             };
         }
         let ctx = self.context(t1, h, s_new);
+        let (iter, rel, history, fref) = self.newton_solve(h, &ctx, Kinematics::Hht)?;
+        self.finish_step(h, &ctx, iter, rel, history, fref)
+    }
+
+    /// Newton's iterations on the increment `u` (from its predictor) until the equations
+    /// at `ctx` hold, the trial state following `u` through `kin`. Returns the iterations,
+    /// the final relative residual, the residual history and the reference force; the
+    /// accepted state is not touched.
+    pub(super) fn newton_solve(
+        &mut self,
+        h: f64,
+        ctx: &EvalContext,
+        kin: Kinematics,
+    ) -> Result<(u32, f64, Vec<f64>, f64), Failure> {
+        let ctx = *ctx;
+        let s_new = ctx.constraint_scale;
+        let nn = self.sys.n_node_eq;
         let mut history = std::mem::take(&mut self.history);
         history.clear();
         // Constraint equations are met to an absolute tolerance (m or rad), with a round-off
@@ -136,7 +156,13 @@ impl Integrator {
             {
                 return Err(self.failure(h, FailureReason::Aborted, history, fref));
             }
-            self.trial_from_u(h);
+            match kin {
+                Kinematics::Hht => self.trial_from_u(h),
+                Kinematics::Stage => {
+                    self.stage_from_u();
+                    self.stage_velocity_rows(&ctx);
+                }
+            }
             if tangent {
                 self.update_tangent_maps();
             }
@@ -147,6 +173,7 @@ impl Integrator {
                 tangent,
                 Some(&self.tmap),
             );
+            self.patch_stage_rows();
             // The forces in play now: the loads at t + h and the elements' own forces, not
             // the largest load of the whole run (a pulse long over, or a huge load, would
             // make any residual look small: issue 28).
@@ -199,75 +226,7 @@ impl Integrator {
                 && (iter == 0 || last_inc <= self.newton.tol_increment)
                 && polished;
             if converged {
-                // A converged state must not hold energy the step cannot pay for.
-                if self.dynamic
-                    && let Some(j) = crate::solver::energy_guard::check_driven(
-                        &self.sys,
-                        &self.nodes,
-                        &self.trial,
-                        self.t,
-                        h,
-                        self.residual_floor * self.sys.ref_length,
-                        self.driver_work(h, &ctx),
-                    )
-                {
-                    return Err(self.failure(
-                        h,
-                        FailureReason::EnergyJump(Box::new(j)),
-                        history,
-                        fref,
-                    ));
-                }
-                if self.dynamic
-                    && let Some(a) = self.adaptive.clone()
-                {
-                    // Local error control before committing (Zienkiewicz & Xie 1991).
-                    let err = self.local_error(h, &a);
-                    let factor = 0.9 * err.max(1e-12).powf(-1.0 / 3.0);
-                    if err > 1.0 && h > self.event_floor * (1.0 + 1e-9) {
-                        let retry = (h * factor.max(0.2)).max(self.event_floor);
-                        return Err(self.failure(
-                            h,
-                            FailureReason::StepRefused(retry),
-                            history,
-                            fref,
-                        ));
-                    }
-                    self.error_next = h * factor.min(a.max_growth);
-                }
-                if self.dynamic {
-                    // Event control before committing: an element may refuse the step.
-                    let (old, new) = (&self.nodes, &self.trial);
-                    let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
-                    for lim in self
-                        .sys
-                        .elements
-                        .iter()
-                        .filter_map(|e| e.step_limit(&ctx, old, new))
-                    {
-                        next = next.min(lim.next);
-                        if h > lim.accept_up_to {
-                            refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
-                        }
-                    }
-                    if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
-                        let retry = retry.max(self.event_floor).min(0.999 * h);
-                        return Err(self.failure(
-                            h,
-                            FailureReason::StepRefused(retry),
-                            history,
-                            fref,
-                        ));
-                    }
-                    self.step_cap = next;
-                }
-                self.accept(h, &ctx);
-                self.history = history;
-                self.stats.newton_iterations += iter as u64;
-                return Ok(StepInfo {
-                    iterations: iter,
-                    residual: rel,
-                });
+                return Ok((iter, rel, history, fref));
             }
             if iter == self.newton.max_iterations {
                 break;
@@ -290,6 +249,7 @@ impl Integrator {
                     true,
                     Some(&self.tmap),
                 );
+                self.patch_stage_rows();
             }
             prev_rel = rel;
             fresh = tangent;
@@ -343,4 +303,80 @@ impl Integrator {
             fref,
         ))
     }
+
+    /// The end of a converged step: the energy guard, the local error (adaptive steps) and
+    /// the elements' step limits may still refuse it; else the trial state is accepted.
+    pub(super) fn finish_step(
+        &mut self,
+        h: f64,
+        ctx: &EvalContext,
+        iter: u32,
+        rel: f64,
+        history: Vec<f64>,
+        fref: f64,
+    ) -> Result<StepInfo, Failure> {
+        let ctx = *ctx;
+        // A converged state must not hold energy the step cannot pay for.
+        if self.dynamic
+            && let Some(j) = crate::solver::energy_guard::check_driven(
+                &self.sys,
+                &self.nodes,
+                &self.trial,
+                self.t,
+                h,
+                self.residual_floor * self.sys.ref_length,
+                self.driver_work(h, &ctx),
+            )
+        {
+            return Err(self.failure(h, FailureReason::EnergyJump(Box::new(j)), history, fref));
+        }
+        if self.dynamic
+            && let Some(a) = self.adaptive.clone()
+        {
+            // Local error control before committing (Zienkiewicz & Xie 1991).
+            let err = self.local_error(h, &a);
+            let factor = 0.9 * err.max(1e-12).powf(-1.0 / 3.0);
+            if err > 1.0 && h > self.event_floor * (1.0 + 1e-9) {
+                let retry = (h * factor.max(0.2)).max(self.event_floor);
+                return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+            }
+            self.error_next = h * factor.min(a.max_growth);
+        }
+        if self.dynamic {
+            // Event control before committing: an element may refuse the step.
+            let (old, new) = (&self.nodes, &self.trial);
+            let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
+            for lim in self
+                .sys
+                .elements
+                .iter()
+                .filter_map(|e| e.step_limit(&ctx, old, new))
+            {
+                next = next.min(lim.next);
+                if h > lim.accept_up_to {
+                    refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
+                }
+            }
+            if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
+                let retry = retry.max(self.event_floor).min(0.999 * h);
+                return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+            }
+            self.step_cap = next;
+        }
+        self.accept(h, &ctx);
+        self.history = history;
+        self.stats.newton_iterations += iter as u64;
+        Ok(StepInfo {
+            iterations: iter,
+            residual: rel,
+        })
+    }
+}
+
+/// How the trial state follows Newton's increment `u`: HHT's update formulas, or those
+/// of an implicit stage of the ESDIRK scheme ([`super::esdirk`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kinematics {
+    Hht,
+    Stage,
 }

@@ -158,16 +158,8 @@ impl Integrator {
         sc.bdot_v.resize(n - nn, 0.0);
         if n > nn && (vmax > 0.0 || wmax > 0.0) {
             let eps = (1e-3 * self.sys.ref_length / vmax.max(1e-300)).min(1e-3 / wmax.max(1e-300));
-            let moved = |sign: f64, nodes: &[NodeState], out: &mut Vec<NodeState>| {
-                out.clear();
-                out.extend(nodes.iter().map(|s| NodeState {
-                    x: s.x + s.v * (sign * eps),
-                    r: s.r * rotation::exp(&(s.w * (sign * eps))),
-                    ..*s
-                }));
-            };
-            moved(1.0, &self.nodes, &mut sc.plus);
-            moved(-1.0, &self.nodes, &mut sc.minus);
+            moved_along_velocities(&self.nodes, eps, &mut sc.plus);
+            moved_along_velocities(&self.nodes, -eps, &mut sc.minus);
             self.sys.assemble(&ctx_s, &self.nodes, &sc.zero, false);
             sc.r0.clear();
             sc.r0.extend_from_slice(&self.sys.rhs[nn..]);

@@ -1,0 +1,516 @@
+//! The lowest modes of a large conservative model by shift-invert block Lanczos on the
+//! project's sparse LU: one factorisation and a few hundred solves, no dense matrix.
+//!
+//! **The constraints stay a saddle-point block.** The dense path eliminates `B q = 0`
+//! through a null-space basis `N` (an `O(n³)` eigen-decomposition of `BᵀB`). Here the
+//! shifted operator keeps them as multipliers, as the iteration matrix of a step does:
+//!
+//! ```text
+//! A(σ) = [ K − σM   s Bᵀ ]      A(σ) [x; μ] = [M v; 0]   ⇒   x = T v,
+//!        [ s B       0   ]      T = N (Nᵀ(K − σM)N)⁻¹ Nᵀ M
+//! ```
+//!
+//! (`s` the constraint scale of the assembly). The second row gives `B x = 0`, so `x = N y`;
+//! the first, projected on `N`, gives `Nᵀ(K − σM)N y = NᵀM v`. For a constrained mode,
+//! `NᵀKN z = ω² NᵀMN z`, `φ = N z`: `T φ = φ/(ω² − σ)`. So the eigenpairs of `T` with
+//! `θ ≠ 0` are the constrained problem's, `θ = 1/(ω² − σ)`, and the modes nearest the
+//! shift have the largest `|θ|` (Ericsson & Ruhe 1980, the spectral transformation;
+//! Géradin & Cardona, *Flexible Multibody Dynamics*, §12 for the saddle point). `T` is
+//! self-adjoint in the mass inner product `⟨u, w⟩ = uᵀMw` on `range N` (for a symmetric
+//! reduced `K`): `wᵀM T v = (Nᵀ M w)ᵀ (Nᵀ(K − σM)N)⁻¹ (NᵀM v)`. Every vector the iteration
+//! makes is an image of `T`, so it satisfies the constraints and has no massless part.
+//! `A(σ)` is regular when `B` has full row rank (redundant joints make it singular: such
+//! models go the dense way) and `σ` is not an eigenvalue.
+//!
+//! **The iteration** (block Lanczos with full reorthogonalisation, thick-restarted: Golub &
+//! Underwood 1977; Grimes, Lewis & Simon, SIAM J. Matrix Anal. Appl. 15(1) 1994): an
+//! `M`-orthonormal basis `Q`, grown by the images `T P` of its last block `P`, each
+//! projected twice on `Q` (Gram–Schmidt twice: the coefficients are the columns of
+//! `H = QᵀM T Q`, and `T Q = Q H + W Eᵀ` with `W` the last block's projected image alone).
+//! The Ritz pairs `(θ, Q s)` of `H` have residual `‖W s_P‖_M`; the iteration stops when the
+//! `count` largest `|θ|` have residuals below [`TOL`]`·|θ|`, and restarts, when `Q` reaches
+//! its maximum size, on the best Ritz vectors (each one's image lies in the span of the
+//! Ritz vectors and `W`, so the relation holds across restarts). A block of `b` vectors
+//! finds eigenvalues of multiplicity up to `b` (a single vector finds one copy of a double
+//! eigenvalue, as a symmetric beam's two bending planes): `b` = [`BLOCK`] covers a free
+//! body's six rigid motions; when a cluster of converged values fills the block, the
+//! iteration is repeated with twice the block.
+//!
+//! The shift: `σ = −10⁻⁸ ω²_max` (the dense path's), with `ω²_max` the largest diagonal
+//! ratio `K_ii/M_ii`: `K − σM` is regular with free rigid motions, which come out as
+//! `θ = 1/|σ|`. `ω² = 1/θ + σ` is exact to `ε|σ|` below `|σ|`; above it the Rayleigh
+//! quotient `φᵀKφ/φᵀMφ` is used (its error is quadratic in the shape's).
+//!
+//! Conservative and undamped only: the reduced `K` and `C` are checked on the final basis
+//! (`QᵀKQ` symmetric to [`super::ASYMMETRY_TOL`] of its largest entry, `QᵀCQ` below
+//! [`super::DAMPED_TOL`] of `√‖QᵀKQ‖`); otherwise [`SparseError::NotConservative`].
+
+use super::linearise::{self, ElementMatrices};
+use crate::elements::NodeState;
+use crate::solver::linear::LinearError;
+use crate::solver::system::System;
+use nalgebra::{DMatrix, SymmetricEigen};
+use rand::{Rng, SeedableRng};
+
+/// Block size: a free body's six rigid motions (a cluster that fills the block doubles it).
+pub const BLOCK: usize = 6;
+/// Relative residual `‖T φ − θ φ‖_M ≤ TOL |θ|` of a converged Ritz pair. The eigenvalue's
+/// error is below the residual's square over the gap (symmetric problem), below the residual
+/// itself inside a cluster: 1e-9 keeps frequencies to ~1e-9 even for exact pairs, and the
+/// Rayleigh quotient of the shape makes it smaller still.
+pub const TOL: f64 = 1e-9;
+/// A vector whose `M`-norm falls below this fraction of its norm before projection is
+/// linearly dependent on the basis (after two Gram–Schmidt passes, round-off leaves ~ε).
+const DROP: f64 = 1e-10;
+/// Relative spread under which converged values are one cluster (a multiple eigenvalue).
+const CLUSTER: f64 = 1e-6;
+
+/// The modes the sparse solve found.
+pub struct SparseModes {
+    /// `(ω², shape)`, lowest first; the shape on the nodal equations, `φᵀMφ = 1`.
+    pub pairs: Vec<(f64, Vec<f64>)>,
+    /// Nodal unknowns less the constraint equations (full row rank: the LU is regular).
+    pub free_unknowns: usize,
+    /// Constraint equations.
+    pub constraints: usize,
+    /// Relative asymmetry of `QᵀKQ` on the final basis.
+    pub asymmetry: f64,
+    /// Per element: its nodal `K` and `M`, for energy shares.
+    pub locals: Vec<ElementMatrices>,
+    /// Solves (applications of `T`), factorisations, final block size.
+    pub solves: usize,
+    /// Numeric factorisations of `A(σ)`.
+    pub factorisations: usize,
+    /// Block size used.
+    pub block: usize,
+    /// The shift `σ`, 1/s².
+    pub shift: f64,
+    /// `ε`-scale threshold below which `|ω²|` is a rigid motion (the dense path's rule with
+    /// the diagonal estimate of `ω²_max`).
+    pub zero: f64,
+}
+
+/// Why the sparse solve did not give modes.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SparseError {
+    /// The model at this state is damped, gyroscopic or non-symmetric.
+    #[error(
+        "the sparse solver handles conservative undamped models: at this state the reduced stiffness is asymmetric to {asymmetry:.1e} and the damping/gyroscopic matrix is {damping:.1e} of it"
+    )]
+    NotConservative {
+        /// Relative asymmetry of `QᵀKQ`.
+        asymmetry: f64,
+        /// `max|QᵀCQ| / √max|QᵀKQ|`.
+        damping: f64,
+    },
+    /// `A(σ)` is singular (redundant constraints, or a free direction with no mass).
+    #[error(
+        "the shifted saddle-point matrix [K - sM, B'; B, 0] is singular ({0}): redundant constraints?"
+    )]
+    Singular(String),
+    /// No mass on the free unknowns.
+    #[error("no mass on any free degree of freedom")]
+    Massless,
+    /// The iteration did not converge within its budget of solves.
+    #[error("shift-invert Lanczos: {converged} of {count} modes converged after {solves} solves")]
+    NoConvergence {
+        /// Converged modes.
+        converged: usize,
+        /// Asked for.
+        count: usize,
+        /// Solves spent.
+        solves: usize,
+    },
+}
+
+impl From<LinearError> for SparseError {
+    fn from(e: LinearError) -> Self {
+        SparseError::Singular(e.to_string())
+    }
+}
+
+/// The nodal `K`, `M`, `C` on the pattern of the system's iteration matrix.
+struct Operator<'a> {
+    sys: &'a mut System,
+    nn: usize,
+    k: Vec<f64>,
+    m: Vec<f64>,
+    c: Vec<f64>,
+    solves: usize,
+}
+
+impl Operator<'_> {
+    /// `y = A x` on the nodal block of the values `a` of the pattern.
+    fn mul(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        let mat = &self.sys.matrix;
+        for (col, xc) in x.iter().enumerate() {
+            if *xc == 0.0 {
+                continue;
+            }
+            for p in mat.position_range(col) {
+                let r = mat.row_of(p);
+                if r < self.nn {
+                    y[r] += a[p] * xc;
+                }
+            }
+        }
+    }
+
+    fn mass(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.nn];
+        self.mul(&self.m, x, &mut y);
+        y
+    }
+
+    /// `T v`: the nodal part of `A(σ)⁻¹ [M v; 0]`.
+    fn apply(&mut self, v: &[f64]) -> Result<Vec<f64>, SparseError> {
+        let mut rhs = vec![0.0; self.sys.n_eq()];
+        self.mul(&self.m, v, &mut rhs[..self.nn]);
+        self.sys.matrix.solve(&mut rhs)?;
+        self.solves += 1;
+        rhs.truncate(self.nn);
+        Ok(rhs)
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
+}
+
+/// An `M`-orthonormal basis with the mass images of its vectors.
+#[derive(Default)]
+struct Basis {
+    q: Vec<Vec<f64>>,
+    mq: Vec<Vec<f64>>,
+}
+
+impl Basis {
+    /// Projects `w` on the basis twice (Gram–Schmidt), returning the summed coefficients.
+    fn project(&self, w: &mut [f64]) -> Vec<f64> {
+        let mut coef = vec![0.0; self.q.len()];
+        for _ in 0..2 {
+            for (i, (q, mq)) in self.q.iter().zip(&self.mq).enumerate() {
+                let c = dot(mq, w);
+                axpy(w, -c, q);
+                coef[i] += c;
+            }
+        }
+        coef
+    }
+
+    /// `M`-orthonormalises `ws` against the basis and each other, appending those that
+    /// are independent; returns how many were appended.
+    fn extend(&mut self, op: &Operator, ws: Vec<Vec<f64>>) -> usize {
+        let mut added = 0;
+        for mut w in ws {
+            let n0 = dot(&op.mass(&w), &w).max(0.0).sqrt();
+            self.project(&mut w);
+            let mw = op.mass(&w);
+            let n1 = dot(&mw, &w).max(0.0).sqrt();
+            if n1 <= DROP * n0 || n1 == 0.0 {
+                continue;
+            }
+            w.iter_mut().for_each(|v| *v /= n1);
+            self.mq.push(mw.into_iter().map(|v| v / n1).collect());
+            self.q.push(w);
+            added += 1;
+        }
+        added
+    }
+
+    /// `Σ_j s_j q_j` over the basis.
+    fn combine(vs: &[Vec<f64>], s: impl Iterator<Item = f64>, n: usize) -> Vec<f64> {
+        let mut y = vec![0.0; n];
+        for (v, sj) in vs.iter().zip(s) {
+            if sj != 0.0 {
+                axpy(&mut y, sj, v);
+            }
+        }
+        y
+    }
+}
+
+/// Assembles the nodal `K`, `M`, `C` on the iteration matrix's pattern, element by element
+/// as the dense path does ([`linearise::element_parts`]); `K` keeps its multiplier rows
+/// and columns (`s B`, `s Bᵀ`).
+fn assemble(
+    sys: &mut System,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<ElementMatrices>) {
+    let nn = sys.n_node_eq;
+    let nnz = sys.matrix.nnz();
+    let (mut k, mut m, mut c) = (vec![0.0; nnz], vec![0.0; nnz], vec![0.0; nnz]);
+    let base = linearise::base_context(sys, scale, t);
+    let mut locals = Vec::with_capacity(sys.elements.len());
+    for e in 0..sys.elements.len() {
+        let p = linearise::element_parts(sys, e, nodes, lambda, &base);
+        let size = p.rows.len();
+        for j in 0..size {
+            let Some(gj) = p.rows[j] else { continue };
+            for i in 0..size {
+                let Some(gi) = p.rows[i] else { continue };
+                let Some(pos) = sys.matrix.position(gi, gj) else {
+                    continue;
+                };
+                let q = j * size + i;
+                k[pos] += p.k[q];
+                if gi < nn && gj < nn {
+                    m[pos] += p.m[q];
+                    c[pos] += p.c[q];
+                }
+            }
+        }
+        locals.push(p.local_matrices());
+    }
+    for (i, j, v) in linearise::moment_stiffness(sys, nodes, t) {
+        if let Some(pos) = sys.matrix.position(i, j) {
+            k[pos] += v;
+        }
+    }
+    (k, m, c, locals)
+}
+
+/// The lowest `count` modes (nearest the shift) of the conservative model at the state,
+/// by shift-invert block Lanczos on the system's sparse LU (module docs). `sys`'s
+/// iteration matrix is overwritten.
+pub fn lowest(
+    sys: &mut System,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+    count: usize,
+) -> Result<SparseModes, SparseError> {
+    let nn = sys.n_node_eq;
+    let constraints = sys.n_eq() - nn;
+    let (k, m, c, locals) = assemble(sys, nodes, lambda, scale, t);
+    // ω²_max estimate: the largest diagonal ratio (a lower bound of the largest eigenvalue).
+    let mut w2max: f64 = 0.0;
+    for i in 0..nn {
+        if let Some(p) = sys.matrix.position(i, i)
+            && m[p] > 0.0
+        {
+            w2max = w2max.max(k[p].abs() / m[p]);
+        }
+    }
+    if w2max == 0.0 {
+        return Err(SparseError::Massless);
+    }
+    let sigma = -1e-8 * w2max;
+    for (a, (kv, mv)) in sys.matrix.values.iter_mut().zip(k.iter().zip(&m)) {
+        *a = kv - sigma * mv;
+    }
+    sys.matrix.factor()?;
+    let mut op = Operator {
+        sys,
+        nn,
+        k,
+        m,
+        c,
+        solves: 0,
+    };
+    let mut block = BLOCK.min(count.max(1));
+    loop {
+        let (theta, basis) = iterate(&mut op, count, block)?;
+        // A cluster of converged values as large as the block may hide more copies.
+        let big = theta.iter().any(|&x| {
+            theta
+                .iter()
+                .filter(|&&y| (x - y).abs() <= CLUSTER * x.abs())
+                .count()
+                >= block
+        });
+        if big && block < nn - constraints && block < 4 * BLOCK {
+            block *= 2;
+            continue;
+        }
+        return finish(op, theta, basis, sigma, w2max, constraints, locals, block);
+    }
+}
+
+/// Block Lanczos (module docs): the `count` Ritz values of largest `|θ|` and their
+/// vectors (`M`-orthonormal).
+fn iterate(
+    op: &mut Operator,
+    count: usize,
+    block: usize,
+) -> Result<(Vec<f64>, Vec<Vec<f64>>), SparseError> {
+    let nn = op.nn;
+    let free = nn - (op.sys.n_eq() - nn);
+    let max_dim = (3 * count).max(count + 3 * block).max(30).min(free);
+    let budget = op.solves + 40 * count + 400;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(24);
+    let mut random_block = |op: &mut Operator, b: usize| -> Result<Vec<Vec<f64>>, SparseError> {
+        (0..b)
+            .map(|_| {
+                let r: Vec<f64> = (0..nn).map(|_| rng.random::<f64>() - 0.5).collect();
+                op.apply(&r)
+            })
+            .collect()
+    };
+    let mut q = Basis::default();
+    let start = random_block(op, block)?;
+    q.extend(op, start);
+    if q.q.is_empty() {
+        return Err(SparseError::Massless);
+    }
+    // H on the expanded vectors (the first `h.nrows()` of the basis).
+    let mut h = DMatrix::<f64>::zeros(0, 0);
+    loop {
+        let m_all = q.q.len();
+        let m_old = h.nrows();
+        let pending: Vec<usize> = (m_old..m_all).collect();
+        let mut ws = Vec::with_capacity(pending.len());
+        let mut hn = DMatrix::<f64>::zeros(m_all, m_all);
+        hn.view_mut((0, 0), (m_old, m_old)).copy_from(&h);
+        for &j in &pending {
+            let mut w = op.apply(&q.q[j].clone())?;
+            let coef = q.project(&mut w);
+            for (i, cf) in coef.into_iter().enumerate() {
+                hn[(i, j)] = cf;
+                if i < m_old {
+                    hn[(j, i)] = cf;
+                }
+            }
+            ws.push(w);
+        }
+        let h_sym = (&hn + hn.transpose()) * 0.5;
+        h = h_sym.clone();
+        // Gram matrix of the remainders, for the residuals.
+        let mws: Vec<Vec<f64>> = ws.iter().map(|w| op.mass(w)).collect();
+        let g = DMatrix::from_fn(ws.len(), ws.len(), |a, b| dot(&mws[a], &ws[b]));
+        let eig = SymmetricEigen::new(h_sym);
+        let mut order: Vec<usize> = (0..m_all).collect();
+        order.sort_by(|&a, &b| {
+            eig.eigenvalues[b]
+                .abs()
+                .total_cmp(&eig.eigenvalues[a].abs())
+        });
+        let wanted = count.min(m_all);
+        let converged = order[..wanted]
+            .iter()
+            .filter(|&&i| {
+                let s = eig.eigenvectors.column(i);
+                let sp = DMatrix::from_fn(pending.len(), 1, |a, _| s[pending[a]]);
+                let r2 = (sp.transpose() * &g * &sp)[(0, 0)].max(0.0);
+                r2.sqrt() <= TOL * eig.eigenvalues[i].abs()
+            })
+            .count();
+        let ritz = |idx: &[usize]| -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+            idx.iter()
+                .map(|&i| {
+                    let s = eig.eigenvectors.column(i);
+                    (
+                        Basis::combine(&q.q, s.iter().copied(), nn),
+                        Basis::combine(&q.mq, s.iter().copied(), nn),
+                    )
+                })
+                .unzip()
+        };
+        if converged == count {
+            let theta = order[..count].iter().map(|&i| eig.eigenvalues[i]).collect();
+            return Ok((theta, ritz(&order[..count]).0));
+        }
+        if op.solves >= budget || m_all >= free {
+            return Err(SparseError::NoConvergence {
+                converged,
+                count,
+                solves: op.solves,
+            });
+        }
+        // Restart on the best Ritz vectors when the next block would not fit.
+        if m_all + pending.len() > max_dim {
+            let keep: Vec<usize> = order[..(count + block).min(m_all)].to_vec();
+            let (vq, vmq) = ritz(&keep);
+            q = Basis { q: vq, mq: vmq };
+            h = DMatrix::from_fn(keep.len(), keep.len(), |a, b| {
+                if a == b {
+                    eig.eigenvalues[keep[a]]
+                } else {
+                    0.0
+                }
+            });
+        }
+        let added = q.extend(op, ws);
+        if added == 0 {
+            // An invariant subspace: continue from fresh random vectors.
+            let fresh = random_block(op, block)?;
+            if q.extend(op, fresh) == 0 {
+                return Err(SparseError::NoConvergence {
+                    converged,
+                    count,
+                    solves: op.solves,
+                });
+            }
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    op: Operator,
+    theta: Vec<f64>,
+    basis: Vec<Vec<f64>>,
+    sigma: f64,
+    w2max: f64,
+    constraints: usize,
+    locals: Vec<ElementMatrices>,
+    block: usize,
+) -> Result<SparseModes, SparseError> {
+    let nn = op.nn;
+    let n = basis.len();
+    let mut kq = Vec::with_capacity(n);
+    let mut cq = Vec::with_capacity(n);
+    for phi in &basis {
+        let mut y = vec![0.0; nn];
+        op.mul(&op.k, phi, &mut y);
+        kq.push(y);
+        let mut y = vec![0.0; nn];
+        op.mul(&op.c, phi, &mut y);
+        cq.push(y);
+    }
+    let kr = DMatrix::from_fn(n, n, |i, j| dot(&basis[i], &kq[j]));
+    let cr = DMatrix::from_fn(n, n, |i, j| dot(&basis[i], &cq[j]));
+    let max_abs = |a: &DMatrix<f64>| a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let kn = max_abs(&kr).max(f64::MIN_POSITIVE);
+    let asymmetry = max_abs(&(&kr - kr.transpose())) / kn;
+    let damping = max_abs(&cr) / kn.sqrt();
+    if asymmetry > super::ASYMMETRY_TOL || damping > super::DAMPED_TOL {
+        return Err(SparseError::NotConservative { asymmetry, damping });
+    }
+    let mut pairs: Vec<(f64, Vec<f64>)> = theta
+        .iter()
+        .zip(basis)
+        .enumerate()
+        .map(|(i, (&th, phi))| {
+            // ω² = 1/θ + σ, exact to ε|σ| below |σ|; above it the Rayleigh quotient
+            // (φᵀMφ = 1).
+            let mut w2 = 1.0 / th + sigma;
+            if w2 > -sigma {
+                w2 = kr[(i, i)];
+            }
+            (w2, phi)
+        })
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(SparseModes {
+        pairs,
+        free_unknowns: nn - constraints,
+        constraints,
+        asymmetry,
+        locals,
+        solves: op.solves,
+        factorisations: op.sys.matrix.pivoting_factorizations() as usize,
+        block,
+        shift: sigma,
+        zero: super::dense::ZERO_FACTOR * f64::EPSILON * w2max,
+    })
+}

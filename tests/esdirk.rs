@@ -1,0 +1,422 @@
+//! The third-order ESDIRK integrator (`ANALYSIS ... ESDIRK3`, `solver::integrator::esdirk`,
+//! issue 26 §2): its coefficients, its observed order on closed-form cases, and the
+//! stability suite's cases (tests/stability.rs) run with it. The tests print what they
+//! measure (`-- --nocapture`); docs/accuracy.md ("A third-order integrator") records it.
+
+mod common;
+
+use common::deck;
+use mecano::model::{Analysis, ElementKind, Model, NodeId, Scheme};
+use mecano::solver::integrator::esdirk::{A, GAMMA};
+use mecano::solver::{self, Observer, RunReport, Snapshot};
+use nalgebra::{Complex, Vector3};
+
+fn esdirk(model: &mut Model, h: f64, end: f64) {
+    assert!(
+        model.set_fixed_step(h, end, Some(Scheme::Esdirk3)),
+        "dynamic deck expected"
+    );
+    assert!(matches!(
+        model.analysis,
+        Analysis::Dynamic {
+            scheme: Scheme::Esdirk3,
+            ..
+        }
+    ));
+}
+
+fn node(model: &Model, id: u32) -> usize {
+    model.nodes.get_index_of(&NodeId(id)).expect("node exists")
+}
+
+/// Per accepted state: t, `E − W_ext + W_damping` (what the run's energy balance keeps
+/// constant up to the integrator's own dissipation), kinetic energy, node states,
+/// constraint violation.
+#[derive(Default)]
+struct Rec {
+    t: Vec<f64>,
+    e: Vec<f64>,
+    kin: Vec<f64>,
+    last: Vec<mecano::elements::NodeState>,
+    viol: f64,
+    /// The powers the balance integrates by the trapezoidal rule: loads' and dampers'.
+    power: Vec<f64>,
+}
+
+impl Observer for Rec {
+    fn state(&mut self, snap: &Snapshot) -> std::io::Result<()> {
+        let i = snap.integ;
+        assert!(i.is_esdirk3(), "the run must use ESDIRK3");
+        let en = i.energies();
+        self.t.push(i.t);
+        self.e
+            .push(en.kinetic + en.strain + en.gravity - i.external_work + i.damping_work);
+        self.kin.push(en.kinetic);
+        let damp: f64 = i
+            .sys
+            .elements
+            .iter()
+            .map(|e| e.dissipated_power(&i.nodes))
+            .sum();
+        self.power.push(i.sys.external_power(i.t, &i.nodes) + damp);
+        self.viol = self.viol.max(i.constraint_violation());
+        self.last.clone_from(&i.nodes);
+        Ok(())
+    }
+}
+
+fn run(model: &Model) -> (RunReport, Rec) {
+    let mut rec = Rec::default();
+    let r = solver::run(model, &mut rec).expect("run starts");
+    (r, rec)
+}
+
+fn max_of(v: &[f64]) -> f64 {
+    v.iter().copied().fold(0.0, f64::max)
+}
+
+/// Largest rise of the energy balance above its initial value.
+fn rise(rec: &Rec) -> f64 {
+    rec.e.iter().map(|e| e - rec.e[0]).fold(f64::MIN, f64::max)
+}
+
+/// What the balance's own quadrature may err by: the works of the loads and dampers are
+/// trapezoidal sums of their powers, each step erring by `h³|P̈|/12`; with `h²P̈` estimated
+/// by the second difference of the recorded powers, `Σ h |ΔΔP| / 12`, doubled for the
+/// estimate's own error (uneven steps at events). HHT's numerical damping hides this
+/// error in its losses; ESDIRK3 damps the resolved motion by only O((ωh)⁴) per step, so a
+/// rise of this size is the measure's, not energy created.
+fn quadrature_bound(rec: &Rec) -> f64 {
+    let (t, p) = (&rec.t, &rec.power);
+    let mut b = 0.0;
+    for k in 1..t.len().saturating_sub(1) {
+        let h = 0.5 * (t[k + 1] - t[k - 1]);
+        b += h * (p[k + 1] - 2.0 * p[k] + p[k - 1]).abs() / 12.0;
+    }
+    2.0 * b
+}
+
+/// Kennedy & Carpenter's conditions, to round-off: order 3 (`bᵀ1 = 1`, `bᵀc = 1/2`,
+/// `bᵀc² = 1/3`, `bᵀAc = 1/6`), stage order 2 (`A c = c²/2` row by row), `γ` the root of
+/// `γ³ − 3γ² + 3γ/2 − 1/6`; and the stability function `R(z) = 1 + z bᵀ(I − zA)⁻¹1` with
+/// `|R(iy)| ≤ 1` on the imaginary axis (A-stable: undamped modes never grow) and
+/// `R(∞) = 0` (L-stable: the unresolved modes are annihilated).
+#[test]
+fn coefficients_are_third_order_and_l_stable() {
+    let b = A[3];
+    let c: Vec<f64> = A.iter().map(|r| r.iter().sum()).collect();
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let c2: Vec<f64> = c.iter().map(|v| v * v).collect();
+    let ac: Vec<f64> = A.iter().map(|r| dot(r, &c)).collect();
+    // 16 digits in the constants: round-off of a few ulps.
+    let tol = 1e-15;
+    assert!((b.iter().sum::<f64>() - 1.0).abs() < tol);
+    assert!((dot(&b, &c) - 0.5).abs() < tol);
+    assert!((dot(&b, &c2) - 1.0 / 3.0).abs() < tol);
+    assert!((dot(&b, &ac) - 1.0 / 6.0).abs() < tol);
+    for i in 0..4 {
+        assert!(
+            (ac[i] - c2[i] / 2.0).abs() < tol,
+            "stage order at stage {i}"
+        );
+    }
+    assert!((GAMMA.powi(3) - 3.0 * GAMMA * GAMMA + 1.5 * GAMMA - 1.0 / 6.0).abs() < tol);
+    // R(z) stage by stage (A is lower triangular): Y_i = (1 + z Σ_{j<i} a_ij Y_j)/(1 − z a_ii).
+    let r = |z: Complex<f64>| {
+        let mut y = [Complex::new(0.0, 0.0); 4];
+        for i in 0..4 {
+            let mut s = Complex::new(1.0, 0.0);
+            for j in 0..i {
+                s += z * A[i][j] * y[j];
+            }
+            y[i] = s / (Complex::new(1.0, 0.0) - z * A[i][i]);
+        }
+        y[3]
+    };
+    for k in -300..=800 {
+        let y = 10f64.powf(f64::from(k) / 100.0);
+        let m = r(Complex::new(0.0, y)).norm();
+        assert!(m <= 1.0 + 1e-14, "|R(i {y:e})| = {m}");
+    }
+    assert!(r(Complex::new(0.0, 1e9)).norm() < 1e-8);
+    // Third order: R(z) − e^z = O(z⁴), so at z = 0.01i the difference is ~1e-8 × C.
+    let z = Complex::new(0.0, 0.01);
+    assert!((r(z) - z.exp()).norm() < 1e-9);
+}
+
+/// The observed order from errors `e` at steps halving: `log2(e_k / e_{k+1})`.
+fn slopes(e: &[f64]) -> Vec<f64> {
+    e.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}
+
+/// The order test of a ladder of halving steps. For a method of order 3 the error is
+/// `C h³ (1 + D h + O(h²))`, so the slope between two levels is `3 + O(h)` and its
+/// deviation from 3 halves with each halving: the last slope is within
+/// `|s_last − s_prev|` of 3 (the rest of a geometric series of ratio ½), plus `O(h²)`.
+/// The test asks for the last slope within twice that of 3 and the slopes' limit,
+/// extrapolated as `2 s_last − s_prev`, within 0.2 of 3: a second-order method (limit 2)
+/// cannot pass, nor a fourth-order one.
+fn assert_third_order(what: &str, e: &[f64]) {
+    let s = slopes(e);
+    let (last, prev) = (s[s.len() - 1], s[s.len() - 2]);
+    let limit = 2.0 * last - prev;
+    let es: Vec<String> = e.iter().map(|x| format!("{x:.3e}")).collect();
+    let ss: Vec<String> = s.iter().map(|x| format!("{x:.3}")).collect();
+    println!(
+        "{what}: errors [{}], slopes [{}], extrapolated slope {limit:.3}",
+        es.join(", "),
+        ss.join(", ")
+    );
+    assert!(
+        (last - 3.0).abs() <= 2.0 * (last - prev).abs() + 0.05,
+        "{what}: last slope {last}"
+    );
+    assert!((limit - 3.0).abs() <= 0.2, "{what}: slope limit {limit}");
+}
+
+/// Runge–Kutta 4 on `θ'' = −(g/L) cos θ` (the simple pendulum, tests/joints.rs): at
+/// dt = 1e-4 s its error over 2 s is ~1e-13 rad (h⁴ scaling from the 1e-3 run), far below
+/// the errors measured here (≥ 4e-8 m).
+fn pendulum_angle(t_end: f64) -> f64 {
+    let f = |y: [f64; 2]| [y[1], -9.81 * y[0].cos()];
+    let dt = 1e-4;
+    let mut y = [0.0, 0.0];
+    for _ in 0..(t_end / dt).round() as usize {
+        let k1 = f(y);
+        let k2 = f([y[0] + dt / 2.0 * k1[0], y[1] + dt / 2.0 * k1[1]]);
+        let k3 = f([y[0] + dt / 2.0 * k2[0], y[1] + dt / 2.0 * k2[1]]);
+        let k4 = f([y[0] + dt * k3[0], y[1] + dt * k3[1]]);
+        for i in 0..2 {
+            y[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+    y[0]
+}
+
+/// The rigid pendulum (IFToMM A01: a HINGE with a 1 m offset, an index-3 constraint that
+/// couples the node's rotation and position) against its ODE reference, at h = 0.02 …
+/// 0.0025 s over 2 s: third order (measured slopes 2.77, 2.90, 2.95; errors 1.6e-5 …
+/// 4.0e-8 m, against 1.1e-2 … 1.7e-4 m for HHT α = −0.1 at the same steps). With the
+/// constraints at the position level at every stage the order is 2 (the index-3 order
+/// reduction of a stage-order-2 method), hence the inner stages' velocity constraints.
+#[test]
+fn third_order_on_the_rigid_pendulum_against_its_ode() {
+    let mut m = deck("simple_pendulum.dat");
+    let t_end = 2.0;
+    let th = pendulum_angle(t_end);
+    let exact = Vector3::new(th.cos(), th.sin(), 0.0);
+    let n2 = node(&m, 2);
+    let mut errs = Vec::new();
+    for h in [0.02, 0.01, 0.005, 0.0025] {
+        esdirk(&mut m, h, t_end);
+        let (r, rec) = run(&m);
+        assert!(r.failure.is_none(), "h = {h}: {}", r.failure.unwrap());
+        // The hinge holds at every step (its Newton tolerance, 1e-11 m).
+        assert!(rec.viol < 1e-11, "violation {:e}", rec.viol);
+        errs.push((rec.last[n2].x - exact).norm());
+    }
+    assert_third_order("rigid pendulum", &errs);
+}
+
+/// The torque-free rigid body of `free_body.dat` (Euler's equations on SO(3), as
+/// `hht_is_second_order_accurate` in tests/dynamics.rs): with no reference, the ratio of
+/// successive differences of the final orientation, `|R_h − R_{h/2}|/|R_{h/2} − R_{h/4}|`,
+/// is `2^p` (measured slopes 2.998, 2.999: the exact `dexp⁻¹` of the stages keeps the
+/// Lie-group scheme third order).
+#[test]
+fn third_order_on_the_free_rigid_body() {
+    let mut m = deck("free_body.dat");
+    let mut finals = Vec::new();
+    for h in [0.04, 0.02, 0.01, 0.005, 0.0025] {
+        esdirk(&mut m, h, 4.0);
+        let (r, rec) = run(&m);
+        assert!(r.failure.is_none(), "h = {h}: {}", r.failure.unwrap());
+        finals.push(rec.last[0].r);
+    }
+    let d: Vec<f64> = finals.windows(2).map(|w| (w[0] - w[1]).norm()).collect();
+    assert_third_order("free rigid body (differences)", &d);
+}
+
+/// Stiff bars (E = 2.1e15, `pendulum_rigid.dat`) and steel (`pendulum.dat`) at h = 1e-4 s
+/// through the torque pulse and the first impact (0.6 s): no failure, the constraints held,
+/// and the energy balance never rises above its start by more than its own quadrature's
+/// error ([`quadrature_bound`]) plus 1e-6 of the largest kinetic energy (the Newton
+/// tolerance's work, as in tests/stability.rs).
+#[test]
+fn stiff_bars_and_the_impact_run_and_never_create_energy() {
+    for d in ["pendulum_rigid.dat", "pendulum.dat"] {
+        let mut m = deck(d);
+        esdirk(&mut m, 1e-4, 0.6);
+        let (r, rec) = run(&m);
+        assert!(r.failure.is_none(), "{d}: {}", r.failure.unwrap());
+        let kmax = max_of(&rec.kin);
+        let loss = rec.e[0] - rec.e.last().unwrap();
+        let bound = 1e-6 * kmax + quadrature_bound(&rec);
+        println!(
+            "{d}: {} steps ({} refused), {:.2} it/step, {} factorisations, violation {:.1e}, \
+             rise {:.1e} (bound {:.1e}) and loss {:.2e} of max kinetic {kmax:.1} J",
+            r.stats.steps,
+            r.stats.rejected_steps,
+            r.stats.newton_iterations as f64 / r.stats.steps as f64,
+            r.stats.factorizations,
+            rec.viol,
+            rise(&rec) / kmax,
+            bound / kmax,
+            loss / kmax
+        );
+        assert!(rec.viol < 1e-10, "{d}: violation {:e}", rec.viol);
+        assert!(rise(&rec) <= bound, "{d}: energy rose");
+    }
+}
+
+/// The bouncing mass (`contact_bounce.dat`) with contact stiffness 1e5 … 1e10 N/m and the
+/// unclipped law (the force jumps by c·q̇ at the onset): the step lands on touch and
+/// release (the CAME's limits), the run restarts there and completes; up to k = 1e8 no
+/// energy is created beyond the balance's quadrature error ([`quadrature_bound`]).
+#[test]
+fn stiff_contact_runs_and_never_creates_energy() {
+    for k in [1e5, 1e6, 1e7, 1e8, 1e9, 1e10] {
+        let mut m = deck("contact_bounce.dat");
+        for el in m.elements.values_mut() {
+            if let ElementKind::Came(d) = &mut el.kind {
+                d.stiffness = k;
+                d.damping = 0.2 * k.sqrt();
+            }
+        }
+        esdirk(&mut m, 1e-4, 0.02);
+        let mut integ = solver::prepare(&m).expect("prepare");
+        integ.set_velocity(
+            node(&m, 2),
+            Vector3::new(0.0, -(2.0 * 9.81f64).sqrt(), 0.0),
+            Vector3::zeros(),
+        );
+        let mut rec = Rec::default();
+        let r = solver::run_prepared(&m, &mut integ, &mut rec).expect("run");
+        assert!(r.failure.is_none(), "k = {k:e}: {}", r.failure.unwrap());
+        let kmax = max_of(&rec.kin);
+        let bound = 1e-6 * kmax + quadrature_bound(&rec);
+        println!(
+            "bounce k = {k:.0e}: {} steps ({} refused), {} restarts, rise {:.1e} (bound {:.1e}) of max kinetic {kmax:.2} J",
+            r.stats.steps,
+            r.stats.rejected_steps,
+            r.stats.restarts,
+            rise(&rec) / kmax,
+            bound / kmax
+        );
+        assert!(
+            r.stats.restarts >= 2,
+            "k = {k:e}: touch and release restart"
+        );
+        // Up to k = 1e8 the rise stays below 7e-5 of the kinetic energy (measured), far
+        // inside the bound. At 1e9 and 1e10 it reaches 2.1e-4 and 0.40 (within the bound,
+        // 0.16 and 0.99, which is then too loose to tell the measure's error from energy the
+        // stages create across the stiff onset): recorded in docs/accuracy.md as open, only
+        // the run's completion is asserted there.
+        if k <= 1e8 {
+            assert!(rise(&rec) <= bound, "k = {k:e}: energy rose");
+        }
+    }
+}
+
+/// The simple pendulum at h = 1e-2 … 1e-6 s (to 0.05 s): converges at every step size
+/// with the constraint held (≤ 1e-11 m) and bounded Newton effort per stage.
+#[test]
+fn step_range_keeps_the_constraint_and_iterations() {
+    for h in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6] {
+        let mut m = deck("simple_pendulum.dat");
+        esdirk(&mut m, h, 0.05f64.max(50.0 * h));
+        let (r, rec) = run(&m);
+        assert!(r.failure.is_none(), "h = {h:e}: {}", r.failure.unwrap());
+        let per_stage = r.stats.newton_iterations as f64 / (3.0 * r.stats.steps as f64);
+        println!(
+            "pendulum h = {h:.0e}: {} steps, {per_stage:.2} it/stage, violation {:.1e}",
+            r.stats.steps, rec.viol
+        );
+        assert!(rec.viol < 1e-11, "h = {h:e}: violation {:e}", rec.viol);
+        // A stage from a good predictor: one solve, a check and at most a few polishing
+        // iterations; 10 per stage would mean the kept matrix no longer contracts.
+        assert!(per_stage < 10.0, "h = {h:e}: {per_stage} it/stage");
+    }
+}
+
+/// The pendulum without floor (10 beams per bar, steel) at h = 1e-3 s, where the beams'
+/// axial and shear modes have ωh up to ~1e3 (HHT α = 0 blows up on them near 2.3 s): 20 s
+/// (2e4 steps) with the energy balance never above its start, its loss reported; the
+/// tumbling bar of `tumbling_beam.dat` (rotation vectors through 2π, 4π, …) for 10 s.
+#[test]
+fn long_runs_stay_bounded() {
+    let mut m = deck("pendulum_nocontact.dat");
+    esdirk(&mut m, 1e-3, 20.0);
+    let (r, rec) = run(&m);
+    assert!(r.failure.is_none(), "{}", r.failure.unwrap());
+    let kmax = max_of(&rec.kin);
+    let loss = rec.e[0] - rec.e.last().unwrap();
+    println!(
+        "long run: {} steps, {:.2} it/step, rise {:.1e}, loss over 20 s {:.2e} of max kinetic {kmax:.1} J",
+        r.stats.steps,
+        r.stats.newton_iterations as f64 / r.stats.steps as f64,
+        rise(&rec) / kmax,
+        loss / kmax
+    );
+    assert!(
+        rise(&rec) <= 1e-6 * kmax,
+        "energy rose by {:e} J",
+        rise(&rec)
+    );
+    let mut m = deck("tumbling_beam.dat");
+    esdirk(&mut m, 0.01, 10.0);
+    let (r, rec) = run(&m);
+    assert!(r.failure.is_none(), "tumbling: {}", r.failure.unwrap());
+    let drift = (rec.e.last().unwrap() - rec.e[0]).abs() / rec.e[0].abs().max(1e-300);
+    println!("tumbling beam: 1000 steps, energy change {drift:.1e} relative");
+    assert!(
+        rise(&rec) <= 1e-6 * max_of(&rec.kin),
+        "tumbling: energy rose"
+    );
+}
+
+/// A run that cannot converge (`stab_diverge.dat`, with ESDIRK3 on its card) fails cleanly:
+/// exit code 1, the diagnosis, `summary.json` incomplete, no NaN in any file.
+#[test]
+fn a_diverging_run_fails_cleanly() {
+    let scratch = common::TempDir::new("esdirk_diverge");
+    let text = std::fs::read_to_string(common::deck_path("stab_diverge.dat")).unwrap();
+    let text = text.replace("ANALYSIS DYNAMIC ALPHA -0.1", "ANALYSIS DYNAMIC ESDIRK3");
+    assert!(text.contains("ESDIRK3"));
+    let deck = scratch.join("diverge.dat");
+    std::fs::write(&deck, text).unwrap();
+    let out_dir = scratch.join("out");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg(&deck)
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .expect("binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    println!("exit {:?}\n{err}", out.status.code());
+    assert_eq!(out.status.code(), Some(1));
+    for needle in [
+        "at t = ",
+        "with step h = ",
+        "relative residual by iteration",
+    ] {
+        assert!(err.contains(needle), "diagnosis lacks {needle:?}: {err}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["complete"], serde_json::json!(false));
+    // The CSVs hold no NaN or infinity; summary.json parsed above (JSON has neither, and its
+    // keys may say "rho_inf").
+    for f in std::fs::read_dir(&out_dir).unwrap() {
+        let p = f.unwrap().path();
+        if p.extension().is_some_and(|e| e == "csv") {
+            let low = std::fs::read_to_string(&p).unwrap().to_ascii_lowercase();
+            assert!(
+                !low.contains("nan") && !low.contains("inf"),
+                "{} has a non-finite value",
+                p.display()
+            );
+        }
+    }
+}
