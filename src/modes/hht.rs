@@ -138,10 +138,8 @@ pub fn compared_schemes(deck: &Scheme) -> Vec<Scheme> {
         Scheme::Hht { alpha },
         Scheme::GeneralizedAlpha { rho_inf: rho },
     ] {
-        let valid = match s {
-            Scheme::Hht { alpha } => Scheme::alpha_ok(alpha),
-            Scheme::GeneralizedAlpha { rho_inf } => Scheme::rho_inf_ok(rho_inf),
-        };
+        // (No match on the variants: another scheme needs no arm here.)
+        let valid = s.hht_alpha().is_none_or(Scheme::alpha_ok) && Scheme::rho_inf_ok(s.rho_inf());
         if valid && s.name() != deck.name() {
             v.push(s);
         }
