@@ -29,8 +29,9 @@ use std::path::{Path, PathBuf};
 pub const FILE_NAME: &str = "checkpoint.bin";
 /// Name of the checkpoint being written (renamed to [`FILE_NAME`] once whole).
 pub const TMP_NAME: &str = "checkpoint.bin.tmp";
-/// Version of the file format; a checkpoint of another version is refused.
-pub const FORMAT_VERSION: u32 = 1;
+/// Version of the file format; a checkpoint of another version is refused. (2: the
+/// integrator's state names the time integration scheme that wrote it.)
+pub const FORMAT_VERSION: u32 = 2;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 
@@ -246,8 +247,8 @@ mod tests {
         d[k] ^= 0x10;
         assert!(why(&d).contains("checksum"));
         let mut v = b.clone();
-        v[8] = 2;
-        assert!(why(&v).contains("version 2"));
+        v[8] = 7;
+        assert!(why(&v).contains("version 7"));
         let mut m = b;
         m[0] = b'X';
         assert!(why(&m).contains("MECANOCK"));

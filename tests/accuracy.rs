@@ -4,7 +4,7 @@
 mod common;
 
 use common::deck;
-use mecano::model::{Adaptive, Analysis, Model};
+use mecano::model::{Adaptive, Analysis, Model, Scheme};
 use mecano::output::History;
 use mecano::solver::Stats;
 use mecano::{rotation, solver};
@@ -168,12 +168,12 @@ fn modified_newton_is_as_accurate_as_full_newton() {
 /// Observed order of fixed-step HHT on the flexible pendulum before the impact
 /// (t ≤ 0.25 s), from three runs: `log₂(|x_h − x_{h/2}| / |x_{h/2} − x_{h/4}|)` over
 /// nodes 12 and 23, sampled every 1 ms.
-fn preimpact_order(name: &str) -> f64 {
+fn preimpact_order(name: &str, scheme: Option<Scheme>) -> f64 {
     let runs: Vec<(Model, History)> = [1.25e-4, 6.25e-5, 3.125e-5]
         .iter()
         .map(|&h| {
             let mut m = deck(name);
-            assert!(m.set_fixed_step(h, 0.25, None));
+            assert!(m.set_fixed_step(h, 0.25, scheme));
             let mut r = History::new((1e-3 / h).round() as u64);
             let report = solver::run(&m, &mut r).expect("runs");
             assert!(report.failure.is_none());
@@ -197,11 +197,22 @@ fn preimpact_order(name: &str) -> f64 {
 /// (1.8–2.2, the issue's band); the triangle's is printed for comparison.
 #[test]
 fn a_smooth_pulse_restores_order_two_before_the_impact() {
-    let smooth = preimpact_order("pendulum_haversine.dat");
-    let triangle = preimpact_order("pendulum.dat");
+    let smooth = preimpact_order("pendulum_haversine.dat", None);
+    let triangle = preimpact_order("pendulum.dat", None);
     eprintln!("order before the impact: haversine {smooth:.2}, triangle {triangle:.2}");
     assert!(
         (1.8..=2.2).contains(&smooth),
         "haversine pulse: order {smooth:.2}"
+    );
+    // Generalized-α (issue 26) is of order 2 too, in the same band.
+    let rho_inf = 0.8;
+    let genalpha = preimpact_order(
+        "pendulum_haversine.dat",
+        Some(Scheme::GeneralizedAlpha { rho_inf }),
+    );
+    eprintln!("order before the impact, generalized-alpha rho_inf {rho_inf}: {genalpha:.2}");
+    assert!(
+        (1.8..=2.2).contains(&genalpha),
+        "generalized-alpha: order {genalpha:.2}"
     );
 }

@@ -353,6 +353,21 @@ fn resume_refuses_an_edited_deck_another_deck_a_complete_or_failed_run_and_a_mis
     let o = resume(&d);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("its text differs"), "{}", text(&o));
+    // Another integrator (issue 26): refused, naming both.
+    let t = std::fs::read_to_string(DECK).unwrap().replace(
+        "ANALYSIS DYNAMIC ALPHA -0.1",
+        "ANALYSIS DYNAMIC GENALPHA RHOINF 0.8",
+    );
+    assert!(t.contains("GENALPHA"));
+    std::fs::write(&deck, &t).unwrap();
+    let o = resume(&d);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("written by the integrator hht:-0.1")
+            && text(&o).contains("now asks for genalpha:0.8"),
+        "{}",
+        text(&o)
+    );
     // Another deck given with --deck: refused.
     let o = run(
         &[

@@ -10,7 +10,7 @@ mod common;
 
 use common::deck;
 use mecano::elements::NodeState;
-use mecano::model::{Adaptive, Analysis, Model};
+use mecano::model::{Adaptive, Analysis, Model, Scheme};
 use mecano::solver::state::IntegratorState;
 use mecano::solver::{self, Integrator, LoopState, Observer, Pause, Snapshot};
 
@@ -152,6 +152,47 @@ fn adaptive_steps_restart_bit_for_bit() {
         });
     }
     check_restarts("contact_bounce adaptive", &m, &[0.3, 0.5, 0.7]);
+    // Generalized-α (issue 26): its pseudo-accelerations (α_m ≠ 0) and the restarts of the
+    // accelerations at the contact's events, with adaptive and fixed steps.
+    if let Analysis::Dynamic { scheme, .. } = &mut m.analysis {
+        *scheme = Scheme::GeneralizedAlpha { rho_inf: 0.8 };
+    }
+    check_restarts("contact_bounce genalpha adaptive", &m, &[0.3, 0.5, 0.7]);
+    let mut fixed = deck("contact_bounce.dat");
+    if let Analysis::Dynamic { scheme, .. } = &mut fixed.analysis {
+        *scheme = Scheme::GeneralizedAlpha { rho_inf: 0.5 };
+    }
+    check_restarts(
+        "contact_bounce genalpha",
+        &fixed,
+        &[0.2, 0.45, 0.5, 0.55, 0.8],
+    );
+}
+
+/// A state saved by one integrator does not restore into another: HHT's pseudo-
+/// accelerations are not generalized-α's (`α_m = 0` vs `α_m ≠ 0`), so the run would go on
+/// from a state its scheme never produced. The refusal names both.
+#[test]
+fn a_state_resumes_only_with_the_integrator_that_wrote_it() {
+    let hht = deck("contact_bounce.dat");
+    let mut rec = Rec {
+        save_at: vec![10],
+        ..Rec::default()
+    };
+    let rep = solver::run(&hht, &mut rec).unwrap();
+    assert!(rep.failure.is_none());
+    let (_, state, _) = rec.saved.pop().expect("saved at step 10");
+    assert_eq!(state.scheme(), "hht:0");
+    let mut other = hht.clone();
+    if let Analysis::Dynamic { scheme, .. } = &mut other.analysis {
+        *scheme = Scheme::GeneralizedAlpha { rho_inf: 0.8 };
+    }
+    let mut integ = solver::prepare(&other).unwrap();
+    let e = integ.restore_state(state).unwrap_err().to_string();
+    assert!(
+        e.contains("integrator hht:0") && e.contains("asks for genalpha:0.8"),
+        "{e}"
+    );
 }
 
 /// Sets the integrator's abort flag at the pause after step `at`, as a second Ctrl-C would.

@@ -17,6 +17,7 @@ use crate::modes::vtk as modes_vtk;
 use crate::modes::{ModalAnalysis, Solver};
 use crate::solver;
 use clap::Args;
+use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -123,6 +124,55 @@ pub fn print_table(out: &mut dyn std::io::Write, a: &ModalAnalysis, step: Option
     }
 }
 
+/// What each integrator does to each mode at the deck's step (issue 26 §4): the numerical
+/// damping ratio and the period error of the deck's scheme and of the others at the same
+/// `ρ∞` ([`crate::modes::hht::compared_schemes`]), closed forms, side by side, so that a
+/// user sees why one needs fewer steps than another for the same phase.
+pub fn print_integrators(out: &mut dyn std::io::Write, a: &ModalAnalysis, st: DeckStep) {
+    let schemes = crate::modes::hht::compared_schemes(&st.scheme);
+    let tables: Vec<_> = schemes
+        .iter()
+        .map(|s| {
+            output::step_resolution(
+                a,
+                DeckStep {
+                    scheme: *s,
+                    h: st.h,
+                },
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        out,
+        "what each integrator does to each mode at h = {:e} s (numerical damping ratio, period error; the deck's first):",
+        st.h
+    );
+    let mut head = format!("  {:>12}", "frequency Hz");
+    for s in &schemes {
+        // `genalpha:0.8181818181818181` → `genalpha:0.8182`: the column's width.
+        let label = s.label();
+        let short = match label.split_once(':').map(|(n, v)| (n, v.parse::<f64>())) {
+            Some((n, Ok(v))) => format!("{n}:{}", (v * 1e4).round() / 1e4),
+            _ => label,
+        };
+        let _ = write!(head, "  {short:>23}");
+    }
+    let _ = writeln!(out, "{head}");
+    for (i, r) in tables[0].iter().enumerate() {
+        let mut line = format!("  {:12.6e}", r.frequency_hz);
+        for t in &tables {
+            let period = t[i]
+                .period_error
+                .map_or("unresolved".to_string(), |e| format!("{e:.3e}"));
+            let _ = write!(line, "  {:>11.3e} {:>11}", t[i].hht_damping, period);
+        }
+        if i + 1 == tables[0].len() {
+            line.push_str("  highest");
+        }
+        let _ = writeln!(out, "{line}");
+    }
+}
+
 /// The lines `--check` adds: the mesh's highest frequency and what the deck's step
 /// resolves of the lowest five modes, about the initial state.
 pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
@@ -141,6 +191,9 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
         Ok(a) => {
             let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
             print_table(out, &a, deck_step(model));
+            if let Some(st) = deck_step(model) {
+                print_integrators(out, &a, st);
+            }
         }
         Err(f) => {
             let _ = writeln!(out, "modes:       not computed ({})", f.message);

@@ -14,6 +14,7 @@ use super::{
 };
 use crate::checkpoint;
 use crate::interrupt::Interrupts;
+use crate::model::Analysis;
 use crate::output::Writer;
 use crate::output::vtk::VtkWriter;
 use crate::solver::{self, RunReport};
@@ -135,6 +136,17 @@ pub fn resume_run(
             ));
         }
     };
+    // Named before the deck's hash (which differs too): the clearer reason.
+    if let Analysis::Dynamic { scheme, .. } = &model.analysis
+        && ck.integrator.scheme() != scheme.label()
+    {
+        return Err(refuse(format!(
+            "the checkpoint was written by the integrator {}, the deck {} now asks for {}: a run resumes only with the integrator that wrote it; a changed deck is a new run",
+            ck.integrator.scheme(),
+            deck_path.display(),
+            scheme.label()
+        )));
+    }
     if id.sha256 != ck.deck.sha256 {
         return Err(refuse(format!(
             "the deck {} is not the one this run's checkpoint belongs to: its text differs (SHA-256 {} now, {} at the run); a changed deck is a new run",

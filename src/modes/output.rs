@@ -145,7 +145,7 @@ pub fn summary(
         serde_json::json!({
             "integrator": st.scheme.name(),
             "alpha": st.scheme.hht_alpha(),
-            "rho_inf": st.scheme.rho_inf(),
+            "high_frequency_radius": st.scheme.rho_inf(),
             "step": st.h,
             "modes": step_resolution(a, st),
             "note": "last row: the mesh's highest frequency; period_error null = not resolved",

@@ -48,14 +48,29 @@ pub fn block(model: &Model, unknowns: usize) -> Option<serde_json::Value> {
         "about": "the initial state (mecano-rs modes)",
         "integrator": step.scheme.name(),
         "alpha": step.scheme.hht_alpha(),
-        "rho_inf": step.scheme.rho_inf(),
+        "high_frequency_radius": step.scheme.rho_inf(),
         "step": step.h,
         "free_unknowns": a.free_unknowns,
         "rigid_modes": a.rigid_modes,
         "highest_frequency_hz": a.highest_hz,
         "modes": step_resolution(&a, step),
-        "note": "one row per elastic mode, lowest first; last row: the mesh's highest frequency; period_error null = not resolved",
+        "integrators": integrators(&a, step),
+        "note": "one row per elastic mode, lowest first; last row: the mesh's highest frequency; period_error null = not resolved; integrators: the same rows for the deck's scheme and the others of its high_frequency_radius (issue 26)",
     }))
+}
+
+/// The rows of [`step_resolution`] for the deck's scheme and each other one at its `ρ∞`
+/// ([`super::hht::compared_schemes`]): what each integrator does to each mode.
+fn integrators(a: &super::ModalAnalysis, step: super::output::DeckStep) -> serde_json::Value {
+    super::hht::compared_schemes(&step.scheme)
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "integrator": s.label(),
+                "modes": step_resolution(a, super::output::DeckStep { scheme: *s, h: step.h }),
+            })
+        })
+        .collect()
 }
 
 /// The lines `mecano-rs study` prints beside its errors: for each step of its ladder, what

@@ -77,6 +77,10 @@ fn restore_pairs(dst: &mut [[Vector3<f64>; 2]], src: &[Pair]) {
 /// Everything of an [`Integrator`] a later step reads (module docs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IntegratorState {
+    /// The time integration scheme that wrote the state ([`crate::model::Scheme::label`]):
+    /// a state resumes only with the same one (another's pseudo-accelerations and history
+    /// mean something else).
+    scheme: String,
     t: f64,
     stats: Stats,
     nodes: Vec<NodeRec>,
@@ -117,6 +121,16 @@ pub enum StateError {
         /// Size in the model.
         model: usize,
     },
+    /// The state was written by another time integration scheme.
+    #[error(
+        "the saved state was written by the integrator {saved}, the model asks for {model}: a run resumes only with the integrator that wrote it"
+    )]
+    Scheme {
+        /// The scheme of the state ([`crate::model::Scheme::label`]).
+        saved: String,
+        /// The model's.
+        model: String,
+    },
     /// An element's state is of another kind of element.
     #[error(transparent)]
     Element(#[from] StateMismatch),
@@ -125,10 +139,18 @@ pub enum StateError {
     Linear(#[from] LinearError),
 }
 
+impl IntegratorState {
+    /// The time integration scheme that wrote the state ([`crate::model::Scheme::label`]).
+    pub fn scheme(&self) -> &str {
+        &self.scheme
+    }
+}
+
 impl Integrator {
     /// The state a restart needs (module docs). Only reads.
     pub fn save_state(&self) -> Result<IntegratorState, StateError> {
         Ok(IntegratorState {
+            scheme: self.scheme.label(),
             t: self.t,
             stats: self.stats,
             nodes: self.nodes.iter().map(NodeRec::from).collect(),
@@ -177,6 +199,12 @@ impl Integrator {
             ("residuals", s.rhs.len(), n),
             ("elements", s.elements.len(), ne),
         ];
+        if s.scheme != self.scheme.label() {
+            return Err(StateError::Scheme {
+                saved: s.scheme,
+                model: self.scheme.label(),
+            });
+        }
         if let Some((what, saved, model)) = checks.into_iter().find(|c| c.1 != c.2) {
             return Err(StateError::Size { what, saved, model });
         }

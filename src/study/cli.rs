@@ -127,6 +127,7 @@ pub fn run(args: &StudyArgs) -> u8 {
         }
     };
     let _ = print_table(&report, &mut io::stdout().lock());
+    let _ = needs::print_needs(&report, &mut io::stdout().lock());
     if let Ok(m) = crate::app::modes::load(&args.deck, &[], opts.refine, None) {
         crate::modes::run_summary::study_lines(&m, &opts.steps, &mut io::stdout().lock());
     }
@@ -138,7 +139,7 @@ pub fn run(args: &StudyArgs) -> u8 {
         }
     }
     println!(
-        "written: {}/study.csv, study_windows.csv, work_precision.svg/.png",
+        "written: {}/study.csv, study_windows.csv, study_needs.csv, work_precision.svg/.png",
         out_dir.display()
     );
     crate::app::EXIT_OK

@@ -29,6 +29,8 @@
 
 mod cli;
 mod figure;
+/// What each integrator needs for 1e-2, 1e-3 and 1e-4 (issue 26 §3).
+pub mod needs;
 mod report;
 mod run;
 /// The space–time study: a ladder of meshes as well as of steps.

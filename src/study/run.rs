@@ -134,9 +134,17 @@ pub fn run_study(
     for &tol in &opts.adaptive {
         configs.push((steps[steps.len() / 2], schemes[0], Some(tol)));
     }
-    let mut records = Vec::new();
-    let mut runs = Vec::new();
-    for (h, a, tol) in &configs {
+    // Runs in interleaved order — every scheme at one step, then the next step — so that
+    // a machine whose load drifts charges the schemes alike (their CPU seconds are
+    // compared); stored in `configs` order (scheme by scheme).
+    let nfix = steps.len();
+    let order: Vec<usize> = (0..nfix)
+        .flat_map(|j| (0..schemes.len()).map(move |k| k * nfix + j))
+        .chain(schemes.len() * nfix..configs.len())
+        .collect();
+    let mut done: Vec<Option<(StudyRun, Vec<Vec<Rec>>)>> = vec![None; configs.len()];
+    for &i in &order {
+        let (h, a, tol) = &configs[i];
         let mut m = base.clone();
         set_run(&mut m, *h, *a, *tol, t_end);
         let label = match tol {
@@ -149,7 +157,7 @@ pub fn run_study(
             recs: vec![Vec::new(); node_idx.len()],
         };
         let report = solver::run(&m, &mut rec).map_err(|e| StudyError::Setup(e.to_string()))?;
-        runs.push(StudyRun {
+        let run = StudyRun {
             label,
             h: *h,
             scheme: *a,
@@ -165,16 +173,17 @@ pub fn run_study(
             error: [f64::NAN; 3],
             order: None,
             fixed_equivalent: None,
-        });
-        records.push(rec.recs);
+        };
+        done[i] = Some((run, rec.recs));
     }
+    let (mut runs, records): (Vec<StudyRun>, Vec<Vec<Vec<Rec>>>) =
+        done.into_iter().flatten().unzip();
     // Sample grid: the coarsest fixed step.
     let dt = steps[0];
     let n_samples = (t_end / dt).round() as usize;
     let nwin = ((t_end / opts.window).ceil() as usize).max(1);
     let windows: Vec<f64> = (0..nwin).map(|k| k as f64 * opts.window).collect();
     // Reference: the finest fixed run of the first scheme.
-    let nfix = steps.len();
     let ref_i = nfix - 1;
     let errors_between = |a: usize, b: usize| -> Vec<[f64; 3]> {
         let mut w = vec![[0.0f64; 3]; nwin];
@@ -265,5 +274,6 @@ pub fn run_study(
         reference_uncertainty,
     };
     write_results(&report, &opts.out_dir)?;
+    super::needs::write_needs(&report, &opts.out_dir)?;
     Ok(report)
 }
