@@ -52,7 +52,7 @@ pub struct ModesArgs {
     /// No table on standard output.
     #[arg(short, long)]
     pub quiet: bool,
-    /// Eigen-solver: `auto` (sparse shift-invert Lanczos from 600 unknowns for a
+    /// Eigen-solver: `auto` (sparse shift-invert Lanczos from 300 unknowns for a
     /// conservative model, dense otherwise), `dense` or `sparse`.
     #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
     pub solver: SolverArg,
