@@ -211,16 +211,16 @@ pub fn frame_xml(
         cells.len()
     );
     s.push_str("      <PointData Vectors=\"displacement\">\n");
-    vecs(&mut s, Some("displacement"), &disp);
-    vecs(&mut s, Some("rotation"), &rot);
-    vecs(&mut s, Some("velocity"), &vel);
-    vecs(&mut s, Some("angular_velocity"), &omega);
+    vecs(&mut s, Some("displacement"), disp);
+    vecs(&mut s, Some("rotation"), rot);
+    vecs(&mut s, Some("velocity"), vel);
+    vecs(&mut s, Some("angular_velocity"), omega);
     s.push_str("      </PointData>\n      <CellData Scalars=\"element\">\n        <DataArray type=\"Int32\" Name=\"element\" format=\"ascii\">\n         ");
     for c in cells {
         let _ = write!(s, " {}", c.0);
     }
     s.push_str("\n        </DataArray>\n      </CellData>\n      <Points>\n");
-    vecs(&mut s, None, &pts);
+    vecs(&mut s, None, pts);
     s.push_str("      </Points>\n      <Cells>\n        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n         ");
     for c in cells {
         let _ = write!(s, " {} {}", c.1, c.2);
