@@ -1,0 +1,577 @@
+//! `KEYWORDS`: the single list of the keywords the parser accepts, each with its section and
+//! documentation; `grammar.md` is tested against it (`tests/grammar_doc.rs`).
+
+/// Documentation of one keyword the parser accepts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KeywordDoc {
+    /// The keyword (upper case; the parser is case-insensitive).
+    pub name: &'static str,
+    /// Where it is used: the section (or card) it belongs to.
+    pub section: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+const fn kw(name: &'static str, section: &'static str, doc: &'static str) -> KeywordDoc {
+    KeywordDoc { name, section, doc }
+}
+
+/// Every keyword the parser accepts, with where it is used: the single source of truth
+/// for `grammar.md` (a test checks that each one is documented there). In debug builds the
+/// parser asserts that every keyword it matches is listed here.
+pub const KEYWORDS: &[KeywordDoc] = &[
+    // sections
+    kw(
+        "TITLE",
+        "deck",
+        "one-line section: the rest of the line is the deck's title",
+    ),
+    kw("MATERIALS", "deck", "section header: material cards follow"),
+    kw(
+        "SECTIONS",
+        "deck",
+        "section header: cross-section cards follow",
+    ),
+    kw("NODES", "deck", "section header: node cards follow"),
+    kw("ELEMENTS", "deck", "section header: element cards follow"),
+    kw(
+        "FUNCTIONS",
+        "deck",
+        "section header: time-function cards follow",
+    ),
+    kw(
+        "LOADS",
+        "deck",
+        "section header: GRAVITY, FORCE and MOMENT cards follow",
+    ),
+    kw(
+        "INITIAL",
+        "deck",
+        "section header: initial-velocity cards follow",
+    ),
+    kw("V", "INITIAL", "initial velocity, global, m/s"),
+    kw("W", "INITIAL", "initial angular velocity, global, rad/s"),
+    kw(
+        "ABOUT",
+        "INITIAL",
+        "centre of a rigid-body velocity field V + W × (x − c)",
+    ),
+    kw("ANALYSIS", "deck", "one-line section: the analysis to run"),
+    kw(
+        "OUTPUT",
+        "deck",
+        "one-line section: what to write and where",
+    ),
+    kw(
+        "END",
+        "deck",
+        "end of the deck: no card after it is read (the file is still checked: UTF-8, limits)",
+    ),
+    kw(
+        "PARAMETERS",
+        "deck",
+        "section header: `name value` cards; fields use them as `$name` in expressions",
+    ),
+    // materials
+    kw("E", "MATERIALS", "Young's modulus, N/m² (> 0)"),
+    kw(
+        "NU",
+        "MATERIALS",
+        "Poisson's ratio (-1 < nu < 0.5); G = E/(2(1+nu))",
+    ),
+    kw("G", "MATERIALS", "shear modulus, N/m² (> 0), instead of NU"),
+    kw("RHO", "MATERIALS", "density, kg/m³ (>= 0)"),
+    kw(
+        "DAMPING",
+        "MATERIALS",
+        "stiffness-proportional damping coefficient, s (>= 0, default 0; also on a PROPERTIES section)",
+    ),
+    // sections
+    kw("A", "SECTIONS", "area, m² (> 0)"),
+    kw(
+        "I2",
+        "SECTIONS",
+        "second moment of area about local axis 2, m⁴",
+    ),
+    kw(
+        "I3",
+        "SECTIONS",
+        "second moment of area about local axis 3, m⁴",
+    ),
+    kw("J", "SECTIONS", "torsion constant, m⁴"),
+    kw(
+        "K",
+        "SECTIONS",
+        "shear correction factor (0 < k <= 1, default 5/6); in ELEMENTS a stiffness (CAME, SPRING, BUSHING, RSPRING)",
+    ),
+    kw(
+        "RIGID",
+        "SECTIONS",
+        "rigid bar section (also an element type in ELEMENTS)",
+    ),
+    kw(
+        "PROPERTIES",
+        "SECTIONS",
+        "the section is given by its stiffness and inertia per unit length (no material)",
+    ),
+    kw("EA", "SECTIONS", "PROPERTIES: axial stiffness EA, N (> 0)"),
+    kw(
+        "GA2",
+        "SECTIONS",
+        "PROPERTIES: shear stiffness along local axis 2, N (> 0)",
+    ),
+    kw(
+        "GA3",
+        "SECTIONS",
+        "PROPERTIES: shear stiffness along local axis 3, N (> 0)",
+    ),
+    kw(
+        "GJ",
+        "SECTIONS",
+        "PROPERTIES: torsional stiffness, N·m² (> 0)",
+    ),
+    kw(
+        "EI2",
+        "SECTIONS",
+        "PROPERTIES: bending stiffness about local axis 2, N·m² (> 0)",
+    ),
+    kw(
+        "EI3",
+        "SECTIONS",
+        "PROPERTIES: bending stiffness about local axis 3, N·m² (> 0)",
+    ),
+    kw(
+        "RHOA",
+        "SECTIONS",
+        "PROPERTIES: mass per unit length, kg/m (>= 0)",
+    ),
+    kw(
+        "RHOJ",
+        "SECTIONS",
+        "PROPERTIES: polar rotary inertia per unit length, kg·m (>= 0)",
+    ),
+    kw(
+        "RHOI2",
+        "SECTIONS",
+        "PROPERTIES: rotary inertia about local axis 2 per unit length, kg·m (>= 0)",
+    ),
+    kw(
+        "RHOI3",
+        "SECTIONS",
+        "PROPERTIES: rotary inertia about local axis 3 per unit length, kg·m (>= 0)",
+    ),
+    // nodes
+    kw(
+        "TO",
+        "NODES",
+        "generation: `<id1> TO <id2>` (also in ELEMENTS)",
+    ),
+    kw(
+        "LINE",
+        "NODES",
+        "nodes evenly spaced on a segment (also a CAME profile)",
+    ),
+    kw("FIX", "NODES", "fix degrees of freedom of a node"),
+    kw(
+        "ALL",
+        "NODES",
+        "all six degrees of freedom (also in OUTPUT: every entity)",
+    ),
+    kw("TRANS", "NODES", "the three translations"),
+    kw("ROT", "NODES", "the three rotations"),
+    kw("X", "NODES", "translation along global X"),
+    kw("Y", "NODES", "translation along global Y"),
+    kw("Z", "NODES", "translation along global Z"),
+    kw("RX", "NODES", "rotation about global X"),
+    kw("RY", "NODES", "rotation about global Y"),
+    kw("RZ", "NODES", "rotation about global Z"),
+    // elements
+    kw(
+        "BEAM",
+        "ELEMENTS",
+        "geometrically exact beam (two nodes, or p + 1 with ORDER)",
+    ),
+    kw(
+        "MAT",
+        "ELEMENTS",
+        "material number of a BEAM (none for a section of PROPERTIES)",
+    ),
+    kw("SEC", "ELEMENTS", "section number of a BEAM"),
+    kw(
+        "DIVIDE",
+        "ELEMENTS",
+        "BEAM: divide into n equal elements, nodes generated on the axis",
+    ),
+    kw(
+        "ORDER",
+        "ELEMENTS",
+        "BEAM: polynomial order p, p - 1 nodes generated at the GLL points",
+    ),
+    kw(
+        "ARC",
+        "ELEMENTS",
+        "BEAM: centre of the circular arc that is the reference axis",
+    ),
+    kw(
+        "AXIS2",
+        "ELEMENTS",
+        "BEAM: local axis 2 direction; UJOINT: axis on the second node",
+    ),
+    kw(
+        "MASS",
+        "ELEMENTS",
+        "point mass with optional rotary inertia",
+    ),
+    kw("M", "ELEMENTS", "mass of a MASS element, kg (>= 0)"),
+    kw(
+        "INERTIA",
+        "ELEMENTS",
+        "rotary inertia of a MASS, kg·m², global frame at t = 0",
+    ),
+    kw("HINGE", "ELEMENTS", "revolute joint"),
+    kw("AXIS", "ELEMENTS", "axis of a HINGE or PRISMATIC joint"),
+    kw("UJOINT", "ELEMENTS", "universal (Cardan) joint"),
+    kw("AXIS1", "ELEMENTS", "UJOINT axis on the first node"),
+    kw("SPHERICAL", "ELEMENTS", "spherical joint"),
+    kw("CLAMP", "ELEMENTS", "two nodes welded together"),
+    kw("PRISMATIC", "ELEMENTS", "prismatic (sliding) joint"),
+    kw(
+        "DRIVE",
+        "ELEMENTS",
+        "HINGE or PRISMATIC: the angle or travel prescribed as a·f(t) (function number)",
+    ),
+    kw(
+        "AMPLITUDE",
+        "ELEMENTS",
+        "DRIVE or PRESCRIBED: the factor a of a·f(t), rad or m (default 1)",
+    ),
+    kw(
+        "PRESCRIBED",
+        "ELEMENTS",
+        "a node's displacement component (X, Y, Z) or rotation about a fixed axis prescribed as a·f(t)",
+    ),
+    kw(
+        "ROTATION",
+        "ELEMENTS",
+        "PRESCRIBED: the node's rotation about a fixed global axis",
+    ),
+    kw("CAME", "ELEMENTS", "cam-follower contact element"),
+    kw("CAM", "ELEMENTS", "CAME: the cam's profile (first node)"),
+    kw(
+        "FOLLOWER",
+        "ELEMENTS",
+        "CAME: the follower's profile (second node)",
+    ),
+    kw("POINT", "ELEMENTS", "CAME profile: a point"),
+    kw(
+        "CIRCLE",
+        "ELEMENTS",
+        "CAME profile: a circle of given radius",
+    ),
+    kw(
+        "SPLINE",
+        "ELEMENTS",
+        "CAME profile: a cubic spline through points (FUNCTIONS: the C² time function)",
+    ),
+    kw(
+        "CLOSED",
+        "ELEMENTS",
+        "CAME SPLINE: a closed (periodic) curve",
+    ),
+    kw(
+        "ANGLE",
+        "ELEMENTS",
+        "CAME LINE: in-plane direction angle, degrees",
+    ),
+    kw(
+        "OFFSET",
+        "ELEMENTS",
+        "CAME profile: origin offset in the node frame, m",
+    ),
+    kw(
+        "PLANE",
+        "ELEMENTS",
+        "CAME profile: plane vectors e1 e2 in the node frame",
+    ),
+    kw(
+        "C",
+        "ELEMENTS",
+        "CAME: contact damping, N·s/m (>= 0, default 0)",
+    ),
+    kw(
+        "MU",
+        "ELEMENTS",
+        "CAME: Coulomb friction coefficient (>= 0, default 0)",
+    ),
+    kw(
+        "VREG",
+        "ELEMENTS",
+        "CAME: friction regularisation speed, m/s (> 0, default 1e-3)",
+    ),
+    kw(
+        "CLIP",
+        "ELEMENTS",
+        "CAME: clip the adhesive part of the contact force (ON/OFF)",
+    ),
+    kw("ON", "ELEMENTS", "CLIP ON"),
+    kw("OFF", "ELEMENTS", "CLIP OFF"),
+    kw(
+        "IMPACT_STEPS",
+        "ELEMENTS",
+        "CAME: minimum steps per impact (>= 1, default 10)",
+    ),
+    kw(
+        "SPRING",
+        "ELEMENTS",
+        "two-node spring-damper along the line of its nodes (K, C, L0 or PRELOAD, CURVE)",
+    ),
+    kw(
+        "L0",
+        "ELEMENTS",
+        "SPRING: free length, m (>= 0; default: initial distance)",
+    ),
+    kw(
+        "PRELOAD",
+        "ELEMENTS",
+        "SPRING: tension at the initial distance, N (instead of L0)",
+    ),
+    kw(
+        "CURVE",
+        "ELEMENTS",
+        "SPRING: function number of a force-deflection curve F(deflection), N",
+    ),
+    kw(
+        "BUSHING",
+        "ELEMENTS",
+        "six-component linear bushing in a frame fixed to its first node",
+    ),
+    kw(
+        "AXES",
+        "ELEMENTS",
+        "BUSHING: axes e1 e2 of its frame, global at t = 0",
+    ),
+    kw(
+        "RSPRING",
+        "ELEMENTS",
+        "rotational spring, damper and friction on a HINGE element",
+    ),
+    kw(
+        "THETA0",
+        "ELEMENTS",
+        "RSPRING: unloaded angle, rad (default 0)",
+    ),
+    kw(
+        "FRICTION",
+        "ELEMENTS",
+        "RSPRING: Coulomb friction torque, N·m (>= 0)",
+    ),
+    kw(
+        "WREG",
+        "ELEMENTS",
+        "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
+    ),
+    kw(
+        "CLEARANCE",
+        "ELEMENTS",
+        "revolute joint with radial clearance (element type; and its clearance, m)",
+    ),
+    kw("RADIUS", "ELEMENTS", "CLEARANCE: bearing radius, m"),
+    kw(
+        "LAW",
+        "ELEMENTS",
+        "CLEARANCE: the normal force law (KV or LN)",
+    ),
+    kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
+    kw(
+        "LN",
+        "ELEMENTS",
+        "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
+    ),
+    kw(
+        "EXPONENT",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
+    ),
+    kw(
+        "VMIN",
+        "ELEMENTS",
+        "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
+    ),
+    // functions
+    kw(
+        "TABLE",
+        "FUNCTIONS",
+        "piecewise-linear table of (t, f) pairs",
+    ),
+    kw("CONSTANT", "FUNCTIONS", "a constant function"),
+    kw(
+        "HAVERSINE",
+        "FUNCTIONS",
+        "a smooth pulse sin²(π(t−t0)/T) on [t0, t0+T]",
+    ),
+    kw(
+        "SLOPES",
+        "FUNCTIONS",
+        "SPLINE: clamped end slopes (default: natural ends)",
+    ),
+    kw("SINE", "FUNCTIONS", "A sin(ω(t − t0) + φ)"),
+    kw("COSINE", "FUNCTIONS", "A cos(ω(t − t0) + φ)"),
+    kw("FREQ", "FUNCTIONS", "SINE/COSINE: frequency, Hz"),
+    kw(
+        "OMEGA",
+        "FUNCTIONS",
+        "SINE/COSINE: circular frequency, rad/s",
+    ),
+    kw(
+        "PHASE",
+        "FUNCTIONS",
+        "SINE/COSINE: phase φ, rad (default 0)",
+    ),
+    kw(
+        "START",
+        "FUNCTIONS",
+        "SINE/COSINE: start time t0, s (0 before it)",
+    ),
+    kw(
+        "RAMP",
+        "FUNCTIONS",
+        "quintic C² step from (t0, f0) to (t1, f1)",
+    ),
+    kw(
+        "EXPR",
+        "FUNCTIONS",
+        "an expression of t (exact derivatives)",
+    ),
+    // loads
+    kw("GRAVITY", "LOADS", "gravity acceleration vector, m/s²"),
+    kw("FORCE", "LOADS", "nodal force, N, global frame"),
+    kw("MOMENT", "LOADS", "nodal moment, N·m, global frame"),
+    kw(
+        "FUNCTION",
+        "LOADS",
+        "time function scaling a FORCE or MOMENT",
+    ),
+    // analysis
+    kw(
+        "DYNAMIC",
+        "ANALYSIS",
+        "implicit dynamics (HHT-alpha, or generalized-alpha with GENALPHA)",
+    ),
+    kw("STATIC", "ANALYSIS", "static equilibrium with load steps"),
+    kw(
+        "MODES",
+        "ANALYSIS",
+        "modal analysis: the lowest n modes about the initial state",
+    ),
+    kw(
+        "ALPHA",
+        "ANALYSIS",
+        "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",
+    ),
+    kw(
+        "GENALPHA",
+        "ANALYSIS",
+        "generalized-alpha time integration instead of HHT",
+    ),
+    kw(
+        "RHOINF",
+        "ANALYSIS",
+        "generalized-alpha: spectral radius at infinity (0 <= rho <= 1, default 0.8)",
+    ),
+    kw("STEP", "ANALYSIS", "time step, s (> 0)"),
+    kw(
+        "ESDIRK3",
+        "ANALYSIS",
+        "third-order L-stable ESDIRK time integrator instead of HHT",
+    ),
+    kw(
+        "MINSTEP",
+        "ANALYSIS",
+        "smallest step when cutting, s (default STEP/1024)",
+    ),
+    kw("MAXSTEP", "ANALYSIS", "largest step, s (default STEP)"),
+    kw("ADAPTIVE", "ANALYSIS", "adaptive time stepping"),
+    kw(
+        "TOLPOS",
+        "ANALYSIS",
+        "adaptive: local error tolerance on positions, m",
+    ),
+    kw(
+        "TOLROT",
+        "ANALYSIS",
+        "adaptive: local error tolerance on rotations, rad",
+    ),
+    kw(
+        "GROWTH",
+        "ANALYSIS",
+        "adaptive: largest step growth factor (>= 1, default 2)",
+    ),
+    kw(
+        "TOL",
+        "ANALYSIS",
+        "Newton residual tolerance (> 0, default 1e-8)",
+    ),
+    kw(
+        "TOLINC",
+        "ANALYSIS",
+        "Newton increment tolerance (> 0, default 1e-10)",
+    ),
+    kw(
+        "MAXIT",
+        "ANALYSIS",
+        "Newton iteration limit (>= 1, default 20)",
+    ),
+    kw(
+        "NEWTON",
+        "ANALYSIS",
+        "FULL (new matrix every iteration) or MODIFIED (default: kept while it contracts)",
+    ),
+    kw("FULL", "ANALYSIS", "NEWTON FULL: full Newton-Raphson"),
+    kw(
+        "MODIFIED",
+        "ANALYSIS",
+        "NEWTON MODIFIED: modified Newton (default)",
+    ),
+    kw(
+        "STEPS",
+        "ANALYSIS",
+        "number of static load steps (>= 1, default 1)",
+    ),
+    // output
+    kw("NONE", "OUTPUT", "no entity"),
+    kw(
+        "EVERY",
+        "OUTPUT",
+        "write a row every n steps (>= 1, default 1)",
+    ),
+    kw(
+        "DIR",
+        "OUTPUT",
+        "output directory (the command line's -o wins)",
+    ),
+    kw("VTK", "OUTPUT", "also write a ParaView series of VTK files"),
+    kw(
+        "FORMAT",
+        "OUTPUT",
+        "CSV (default: node_<N>.csv, element_<N>.csv) or NETCDF (one histories.nc)",
+    ),
+    kw(
+        "CSV",
+        "OUTPUT",
+        "FORMAT CSV: one CSV file per node and element",
+    ),
+    kw(
+        "NETCDF",
+        "OUTPUT",
+        "FORMAT NETCDF: every history in one NetCDF file, histories.nc",
+    ),
+];
+
+/// In debug builds, checks that the parser only matches keywords listed in [`KEYWORDS`].
+#[inline]
+pub(crate) fn debug_check_keyword(kw: &str) {
+    debug_assert!(
+        KEYWORDS.iter().any(|k| k.name == kw),
+        "keyword {kw} is accepted by the parser but missing from KEYWORDS"
+    );
+}
