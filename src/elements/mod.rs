@@ -297,6 +297,23 @@ impl Local {
         self.res[i + 2] += v.z;
     }
 
+    /// Adds a two-node element's residual computed in 12-component dual numbers (seeded on
+    /// `[δx₁, δΘ₁, δx₂, δΘ₂]`): the values to the residual, their derivatives to the first
+    /// 12 columns of the tangent (CAME and CLEARANCE).
+    pub fn add_dual12(&mut self, res: &[Vector3<num_dual::DualSVec64<12>>; 4]) {
+        for (blk, v) in res.iter().enumerate() {
+            for comp in 0..3 {
+                let row = 3 * blk + comp;
+                self.res[row] += v[comp].re;
+                if let Some(eps) = &v[comp].eps.0 {
+                    for col in 0..12 {
+                        self.tan[col * self.n + row] += eps[col];
+                    }
+                }
+            }
+        }
+    }
+
     /// Adds a 3×3 block at local (row `i`, column `j`).
     #[inline]
     pub fn add_block(&mut self, i: usize, j: usize, m: &Matrix3<f64>) {

@@ -6,7 +6,7 @@ use crate::elements::{
     Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, StepLimit,
 };
 use crate::model::ElementId;
-use nalgebra::{Matrix3, SVector, Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 use num_dual::Derivative;
 use std::sync::atomic::Ordering;
 
@@ -99,19 +99,7 @@ impl Element for Came {
             true,
             damped,
         );
-        let n = out.n;
-        for (blk, v) in st.res.iter().enumerate() {
-            for comp in 0..3 {
-                let row = 3 * blk + comp;
-                out.res[row] += v[comp].re;
-                if let Some(eps) = &v[comp].eps.0 {
-                    let eps: &SVector<f64, 12> = eps;
-                    for col in 0..12 {
-                        out.tan[col * n + row] += eps[col];
-                    }
-                }
-            }
-        }
+        out.add_dual12(&st.res);
     }
 
     fn energies(&self, nodes: &[NodeState], _gravity: &Vector3<f64>) -> Energies {

@@ -7,7 +7,7 @@ use crate::elements::{
     Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, StepLimit,
 };
 use crate::model::ElementId;
-use nalgebra::{Const, Matrix3, SVector, U1, Vector3};
+use nalgebra::{Const, Matrix3, U1, Vector3};
 use num_dual::{Derivative, DualSVec64};
 use std::sync::atomic::Ordering;
 
@@ -67,19 +67,7 @@ impl Element for Clearance {
             true,
             damped,
         );
-        let n = out.n;
-        for (blk, v) in st.res.iter().enumerate() {
-            for comp in 0..3 {
-                let row = 3 * blk + comp;
-                out.res[row] += v[comp].re;
-                if let Some(eps) = &v[comp].eps.0 {
-                    let eps: &SVector<f64, 12> = eps;
-                    for col in 0..12 {
-                        out.tan[col * n + row] += eps[col];
-                    }
-                }
-            }
-        }
+        out.add_dual12(&st.res);
     }
 
     fn energies(&self, nodes: &[NodeState], _gravity: &Vector3<f64>) -> Energies {
