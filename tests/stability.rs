@@ -767,8 +767,10 @@ fn clearance_joint_hard_impact_over_the_step_range() {
         pens.push(pen);
     }
     // The same impact with steps that may not be cut (MINSTEP = STEP = 1e-4 s, 3 steps per
-    // crossing of the clearance and none per impact): the run goes through, but it is not
-    // silently wrong: the joint counts the steps it had to accept unresolved.
+    // crossing of the clearance and none per impact). Accepting the joint's refused steps
+    // created 76 J of 12.5 J (stop 24's measurement): a wrong answer. The run must stop at
+    // the first impact with the diagnosis naming the joint and the step it needs, with
+    // the histories up to there and no energy created before it.
     let mut model = deck("stab_clearance_impact.dat");
     set_steps(&mut model, 1e-4, 2e-3, None);
     if let mecano::model::Analysis::Dynamic { min_step, .. } = &mut model.analysis {
@@ -777,14 +779,37 @@ fn clearance_joint_hard_impact_over_the_step_range() {
     let mut integ = solver::prepare(&model).expect("prepare");
     let mut rec = Rec::default();
     let rep = solver::run_prepared(&model, &mut integ, &mut rec).expect("run starts");
-    let s = integ.sys.elements[0].summary().expect("summary");
+    let f = rep
+        .failure
+        .as_ref()
+        .expect("an unresolvable impact stops the run");
     println!(
-        "clearance impact, h = MINSTEP = 1e-4: {:?}, {} unresolved steps, rise {:.2e} J",
-        rep.failure.as_ref().map(|f| f.to_string()),
-        s["unresolved_steps"],
-        rise(&rec)
+        "clearance impact, h = MINSTEP = 1e-4: stops at t = {:.3e} s after {} steps: {f}",
+        f.time, rep.stats.steps
     );
-    assert!(s["unresolved_steps"].as_u64().unwrap() > 0);
+    let id = integ.sys.elements[0].id();
+    match f.reason {
+        solver::FailureReason::EventUnresolved { element, asks } => {
+            assert_eq!(element, id);
+            assert!(asks < 1e-4, "asks for a shorter step: {asks}");
+        }
+        ref r => panic!("expected EventUnresolved, got {r:?}"),
+    }
+    assert!(
+        f.to_string().contains("MINSTEP"),
+        "the message says what to change"
+    );
+    // The journal starts at the centre, 0.5 mm from the wall, at 5 m/s
+    // (it reaches the wall at t = 1e-4 s; the refused step starts there or one step later).
+    assert!(
+        f.time <= 2e-4 + 1e-12,
+        "stops at the first impact, t = {}",
+        f.time
+    );
+    assert!(
+        rise(&rec) <= 1e-6 * rec.e[0],
+        "no energy created before the stop"
+    );
     let (m, v0, k) = (1.0, 5.0, 6.61e10f64);
     let hertz = (5.0 * m * v0 * v0 / (4.0 * k)).powf(0.4);
     let law = common::impact::lankarani_nikravesh(k, 1.5, 0.9, v0);

@@ -497,6 +497,13 @@ pub struct StepLimit {
     pub retry: f64,
     /// The largest next step when accepted, s.
     pub next: f64,
+    /// A refusal because the step cannot resolve the event at all (longer than the
+    /// impact's resolution `π/(ω · IMPACT_STEPS)` times the slack, or it jumped over a
+    /// whole impact), not merely to land an event time more precisely. At the run's
+    /// smallest step the integrator accepts a landing refusal (the event is then timed
+    /// within that step) but stops on an unresolved one
+    /// ([`crate::solver::FailureReason::EventUnresolved`]).
+    pub unresolved: bool,
 }
 
 /// Index of node `k`'s translational block in a local vector.

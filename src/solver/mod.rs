@@ -59,6 +59,16 @@ pub enum FailureReason {
     /// and work can pay for ([`energy_guard`]): a spurious root, refused like a divergence.
     /// (Boxed: `Failure` travels in `Result`s.)
     EnergyJump(Box<energy_guard::EnergyJump>),
+    /// An element refused a step already at the run's smallest step (`MINSTEP`): its
+    /// event (e.g. an impact) would be resolved by fewer steps than it needs, and
+    /// accepting the step anyway can create energy (76 J of 12.5 J in a steel clearance
+    /// impact with `MINSTEP = STEP`, docs/stability.md). Not retried: the run stops.
+    EventUnresolved {
+        /// The element that refused.
+        element: crate::model::ElementId,
+        /// The step it asks for, s.
+        asks: f64,
+    },
     /// The run was asked to stop at once ([`Integrator::abort`], e.g. a second Ctrl-C):
     /// not a failure of the step, which was given up.
     Aborted,
@@ -99,6 +109,10 @@ impl std::fmt::Display for Failure {
                 format!("an element refused the step (asks for h <= {h:.3e} s)")
             }
             FailureReason::Aborted => "the run was aborted".to_string(),
+            FailureReason::EventUnresolved { element, asks } => format!(
+                "element {} needs steps of at most {asks:.3e} s to resolve its event (an impact), but the step may not be cut below MINSTEP = {:.3e} s; lower MINSTEP on the ANALYSIS card",
+                element.0, self.step
+            ),
             FailureReason::EnergyJump(j) => format!(
                 "the step created {:.3e} J of energy that no work paid for (energy in play {:.3e} J before the step, {:.3e} J after, work of the step {:.3e} J): a spurious solution, refused",
                 j.created, j.before, j.after, j.work

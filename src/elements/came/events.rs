@@ -72,11 +72,14 @@ impl Came {
             }
             t
         };
+        // Longer than the impact's resolution: a refusal the smallest step cannot waive.
+        let too_long = h > LIMIT_SLACK * h_imp;
         let refuse = |retry: f64| {
             Some(StepLimit {
                 accept_up_to: 0.0,
                 retry,
                 next: retry,
+                unresolved: too_long,
             })
         };
         if !in0 && st1.gap < 0.0 {
@@ -114,7 +117,10 @@ impl Came {
                     Some(t) if t < h => t,
                     _ => h / 4.0,
                 };
-                return refuse(retry.min(h_imp));
+                return Some(StepLimit {
+                    unresolved: true,
+                    ..refuse(retry.min(h_imp))?
+                });
             }
         } else if h > LIMIT_SLACK * h_imp {
             return refuse(h_imp);
@@ -129,6 +135,7 @@ impl Came {
             accept_up_to: f64::INFINITY,
             retry: next,
             next,
+            unresolved: false,
         })
     }
 

@@ -131,11 +131,14 @@ impl Clearance {
             }
             t
         };
+        // Longer than the impact's resolution: a refusal the smallest step cannot waive.
+        let too_long = h > LIMIT_SLACK * h_imp;
         let refuse = |retry: f64| {
             Some(StepLimit {
                 accept_up_to: 0.0,
                 retry,
                 next: retry,
+                unresolved: too_long,
             })
         };
         let retry_from_start = || match time_to_event(&st0, old) {
@@ -162,7 +165,10 @@ impl Clearance {
         } else if !in0 && !in1 {
             // Apart at both ends: did the step jump over a whole impact?
             if st0.pen_rate > 0.0 && st1.pen_rate < 0.0 && st0.pen + st0.pen_rate * h > 0.0 {
-                return refuse(retry_from_start().min(h_imp));
+                return Some(StepLimit {
+                    unresolved: true,
+                    ..refuse(retry_from_start().min(h_imp))?
+                });
             }
         } else if h > LIMIT_SLACK * h_imp {
             return refuse(h_imp);
@@ -180,6 +186,7 @@ impl Clearance {
             accept_up_to: f64::INFINITY,
             retry: next,
             next,
+            unresolved: false,
         })
     }
 }

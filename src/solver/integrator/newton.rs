@@ -346,20 +346,30 @@ impl Integrator {
             // Event control before committing: an element may refuse the step.
             let (old, new) = (&self.nodes, &self.trial);
             let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
-            for lim in self
-                .sys
-                .elements
-                .iter()
-                .filter_map(|e| e.step_limit(&ctx, old, new))
-            {
+            let mut unresolved = None::<(f64, crate::model::ElementId)>;
+            for e in self.sys.elements.iter() {
+                let Some(lim) = e.step_limit(&ctx, old, new) else {
+                    continue;
+                };
                 next = next.min(lim.next);
                 if h > lim.accept_up_to {
                     refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
+                    if lim.unresolved && unresolved.is_none() {
+                        unresolved = Some((lim.retry, e.id()));
+                    }
                 }
             }
             if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
                 let retry = retry.max(self.event_floor).min(0.999 * h);
                 return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+            }
+            // At the smallest step the run allows a refusal cannot be honoured. One that
+            // only lands an event more precisely is waived (the event is timed within this
+            // step); one that cannot resolve the event at all would integrate an impact in
+            // too few steps, which can create energy no work paid for: stop, diagnosed.
+            if let Some((asks, element)) = unresolved {
+                let why = FailureReason::EventUnresolved { element, asks };
+                return Err(self.failure(h, why, history, fref));
             }
             self.step_cap = next;
         }
