@@ -98,8 +98,8 @@ fn at_angle(rec: &Rec, y: &[f64], target: f64) -> Vec<f64> {
 }
 
 /// The ideal twin: the slider's acceleration at θ = 0 and π against the closed form of the
-/// rigid mechanism at constant ω, `−rω²(1 + r/l)` and `+rω²(1 − r/l)` (the flywheel holds ω
-/// to 3e-9 over the run). Tolerance: HHT is second-order, its error on a harmonic kω of the
+/// rigid mechanism at constant ω, `−rω²(1 + r/l)` and `+rω²(1 − r/l)` (the crank's hinge is
+/// driven by θ = ωt: ω is exact). Tolerance: HHT is second-order, its error on a harmonic kω of the
 /// motion is of order (kωh)² of that harmonic's amplitude; the slider's motion is the
 /// harmonic ω (amplitude rω²) and, to within (r/l)³, 2ω (amplitude rω² r/l): relative
 /// error ≤ (ωh)² (1 + 4 r/l)/(1 ∓ r/l).

@@ -135,6 +135,16 @@ impl Integrator {
         // Constraint equations are met to an absolute tolerance (m or rad), with a round-off
         // floor for very large models.
         let tol_len = CONSTRAINT_TOL.max(100.0 * f64::EPSILON * self.sys.ref_length);
+        // A driver's row `s Φ₆` compares an angle of up to π (a hinge's or a rotation's)
+        // with its law: its round-off is s ε π, not the s ε L_ref of a row in lengths that
+        // the floor below counts. With L_ref < π (a small mechanism) Newton stagnated one
+        // ulp of the angle above the tolerance at the 1e-8 s steps of an impact
+        // (decks/benchmarks/slider_crank_clearance.dat driven: 1.17e-8 against 1e-8).
+        let driver_floor = if self.sys.elements.iter().any(|e| e.rheonomic()) {
+            10.0 * f64::EPSILON * std::f64::consts::PI * s_new
+        } else {
+            0.0
+        };
         let mut last_inc = f64::INFINITY;
         let mut prev_inc = f64::INFINITY;
         let mut fref = self.sys.ref_force;
@@ -191,6 +201,7 @@ impl Integrator {
             // Round-off of the inertia terms: positions known to ε L_ref, angles to ε rad
             // (a body spinning exactly about a principal axis has nothing else to scale by).
             let floor = self.residual_floor
+                + driver_floor
                 + 10.0
                     * f64::EPSILON
                     * ctx.c_a
