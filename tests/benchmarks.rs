@@ -329,3 +329,105 @@ fn flexible_slider_crank_mid_span_deflection_follows_the_modal_route() {
     // The comparison is not empty: the rod does bend (about 1 % of its length).
     assert!(peak > 5e-3, "{peak}");
 }
+
+// ---------------------------------------------------------------- spatial four-bar
+
+#[path = "benchmarks/four_bar.rs"]
+mod four_bar;
+
+/// The deck's nodes of the route's nine (`four_bar::NODES`, in its order).
+const FOUR_BAR_NODES: [u32; four_bar::NODES] = [10, 11, 12, 20, 21, 22, 30, 31, 32];
+
+/// The four-bar's nodes' displacements and rotation vectors (relative to t = 0) at every
+/// recorded instant.
+fn four_bar_motion(m: &Model, h: &History) -> Vec<[(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>); 9]> {
+    let idx = FOUR_BAR_NODES.map(|n| m.nodes.get_index_of(&NodeId(n)).expect("node exists"));
+    h.nodes
+        .iter()
+        .map(|s| {
+            idx.map(|i| {
+                let r = nalgebra::Rotation3::from_matrix_unchecked(s[i].r * h.nodes[0][i].r.transpose());
+                (s[i].x - h.nodes[0][i].x, r.scaled_axis())
+            })
+        })
+        .collect()
+}
+
+/// The deck as a static analysis of `steps` load steps (its drivers follow f(t) for
+/// t = i/steps), with the deck's Newton settings.
+fn as_static(mut m: Model, steps: u32) -> Model {
+    if let mecano::model::Analysis::Dynamic { newton, .. } = m.analysis.clone() {
+        m.analysis = mecano::model::Analysis::Static { steps, newton };
+    }
+    m
+}
+
+/// Largest difference of two sets of nodal (u, φ) over the out-of-plane components (u_z,
+/// φ_x, φ_y) and over the in-plane ones (u_x, u_y, φ_z).
+fn four_bar_diff(
+    a: &[(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)],
+    b: &[(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)],
+) -> (f64, f64) {
+    let mut out = 0f64;
+    let mut inp = 0f64;
+    for ((ua, fa), (ub, fb)) in a.iter().zip(b) {
+        out = out.max((ua.z - ub.z).abs()).max((fa.x - fb.x).abs()).max((fa.y - fb.y).abs());
+        inp = inp.max((ua.x - ub.x).abs()).max((ua.y - ub.y).abs()).max((fa.z - fb.z).abs());
+    }
+    (out, inp)
+}
+
+/// The four-bar's response to a small crank angle against the linear frame of
+/// `benchmarks/four_bar.rs` (the published solution is a plot only, not read): the deck
+/// as a static analysis without gravity at θ = −1e-3 and −2e-3 rad, its nodes' (u, φ) per
+/// radian against the route's, over all nine nodes (the bars' ends and middles). Out of
+/// the plane, what the misalignment causes (u_z of the middles 1e-3 m/rad); in the plane,
+/// the rigid mechanism's motion. Tolerance, each part derived:
+/// - the terms of higher order in θ: the response per radian is s₁ + s₂θ + …, so
+///   |s(θ) − s₁| ≈ |s(2θ) − s(θ)|; twice that covers the cubic terms while |s₃θ| < |s₂|/3;
+/// - the beams' discretisation: the run with beams of order 8 against order 4 (the
+///   route's solution, cubic in the deflection and quadratic in the rotation, lies in both
+///   spaces: both should be exact to Newton's tolerance);
+/// - Newton's tolerance (1e-10 of the model's length, 0.24 m): 2.4e-11 m over θ = 1e-3,
+///   2.4e-8 per radian; 1e-7 allowed.
+#[test]
+fn four_bar_small_angles_follow_the_linear_frame() {
+    let route = four_bar::FourBar {
+        l: 0.12,
+        beta: 5f64.to_radians(),
+        thick: four_bar::Section { ea: 52.99e6, kga: 16.88e6, gj: 733.5, ei: 1131.0 },
+        thin: four_bar::Section { ea: 13.25e6, kga: 4.220e6, gj: 45.84, ei: 70.66 },
+    }
+    .per_radian();
+    let per_radian = |theta: f64, p: f64| {
+        let m = as_static(bench("four_bar_bauchau.dat", &[("w", theta), ("g", 0.0), ("p", p)]), 1);
+        let (h, _) = run(&m);
+        let last = *four_bar_motion(&m, &h).last().expect("a step");
+        last.map(|(u, f)| (u / theta, f / theta))
+    };
+    let theta = -1e-3;
+    let (s1, s2, s8) = (per_radian(theta, 4.0), per_radian(2.0 * theta, 4.0), per_radian(theta, 8.0));
+    let (nl_out, nl_in) = four_bar_diff(&s1, &s2);
+    let (fe_out, fe_in) = four_bar_diff(&s1, &s8);
+    let (d_out, d_in) = four_bar_diff(&s1, &route);
+    let mid = route[4].0.z;
+    let tol_out = 2.0 * nl_out + fe_out + 1e-7;
+    let tol_in = 2.0 * nl_in + fe_in + 1e-7;
+    eprintln!(
+        "four-bar, per radian of crank angle at θ = {theta}: out of the plane |Δ| {d_out:.3e} \
+         (tolerance {tol_out:.3e}: higher order {nl_out:.2e}, order 8 vs 4 {fe_out:.2e}); \
+         in the plane {d_in:.3e} (tolerance {tol_in:.3e}: {nl_in:.2e}, {fe_in:.2e}); \
+         coupler's middle u_z/θ: run {:.6e}, route {mid:.6e} m/rad",
+        s1[4].0.z
+    );
+    for (k, ((u, f), (ur, fr))) in s1.iter().zip(&route).enumerate() {
+        eprintln!(
+            "  node {}: u/θ {:+.5e} {:+.5e} {:+.5e} φ/θ {:+.5e} {:+.5e} {:+.5e} | route {:+.5e} {:+.5e} {:+.5e} {:+.5e} {:+.5e} {:+.5e}",
+            FOUR_BAR_NODES[k], u.x, u.y, u.z, f.x, f.y, f.z, ur.x, ur.y, ur.z, fr.x, fr.y, fr.z
+        );
+    }
+    assert!(d_out <= tol_out, "out of the plane {d_out} > {tol_out}");
+    assert!(d_in <= tol_in, "in the plane {d_in} > {tol_in}");
+    // Not empty: the misalignment bends the loop out of its plane.
+    assert!(mid.abs() > 1e-4, "{mid}");
+}
