@@ -88,7 +88,10 @@ impl FourBar {
         ];
         for (a, b, s) in beams {
             let ke = beam_stiffness(x[a], x[b], s);
-            let dofs: Vec<usize> = (0..6).map(|i| 6 * a + i).chain((0..6).map(|i| 6 * b + i)).collect();
+            let dofs: Vec<usize> = (0..6)
+                .map(|i| 6 * a + i)
+                .chain((0..6).map(|i| 6 * b + i))
+                .collect();
             for (i, &gi) in dofs.iter().enumerate() {
                 for (j, &gj) in dofs.iter().enumerate() {
                     k[(gi, gj)] += ke[(i, j)];
@@ -141,7 +144,10 @@ impl FourBar {
             }
             rhs[n + r] = scale * d;
         }
-        let q = kkt.lu().solve(&rhs).expect("the linear frame is determinate");
+        let q = kkt
+            .lu()
+            .solve(&rhs)
+            .expect("the linear frame is determinate");
         std::array::from_fn(|i| {
             (
                 Vector3::new(q[6 * i], q[6 * i + 1], q[6 * i + 2]),
@@ -163,7 +169,14 @@ fn beam_stiffness(a: Vector3<f64>, b: Vector3<f64>, s: Section) -> DMatrix<f64> 
     let mut kl = DMatrix::<f64>::zeros(12, 12);
     let ka = s.ea / l;
     let kt = s.gj / l;
-    for (i, j, v) in [(0, 0, ka), (0, 6, -ka), (6, 6, ka), (3, 3, kt), (3, 9, -kt), (9, 9, kt)] {
+    for (i, j, v) in [
+        (0, 0, ka),
+        (0, 6, -ka),
+        (6, 6, ka),
+        (3, 3, kt),
+        (3, 9, -kt),
+        (9, 9, kt),
+    ] {
         kl[(i, j)] += v;
         if i != j {
             kl[(j, i)] += v;
@@ -177,9 +190,19 @@ fn beam_stiffness(a: Vector3<f64>, b: Vector3<f64>, s: Section) -> DMatrix<f64> 
         let dofs = [tr, rot, tr + 6, rot + 6];
         let m = [
             [12.0, sg * 6.0 * l, -12.0, sg * 6.0 * l],
-            [sg * 6.0 * l, (4.0 + phi) * l * l, -sg * 6.0 * l, (2.0 - phi) * l * l],
+            [
+                sg * 6.0 * l,
+                (4.0 + phi) * l * l,
+                -sg * 6.0 * l,
+                (2.0 - phi) * l * l,
+            ],
             [-12.0, -sg * 6.0 * l, 12.0, -sg * 6.0 * l],
-            [sg * 6.0 * l, (2.0 - phi) * l * l, -sg * 6.0 * l, (4.0 + phi) * l * l],
+            [
+                sg * 6.0 * l,
+                (2.0 - phi) * l * l,
+                -sg * 6.0 * l,
+                (4.0 + phi) * l * l,
+            ],
         ];
         for i in 0..4 {
             for j in 0..4 {
