@@ -371,3 +371,10 @@ fn flexible_slider_crank_mid_span_deflection_follows_the_modal_route() {
     // The comparison is not empty: the rod does bend (about 1 % of its length).
     assert!(peak > 5e-3, "{peak}");
 }
+
+// ---------------------------------------------------------------- spatial four-bar
+
+#[path = "benchmarks/four_bar.rs"]
+mod four_bar;
+#[path = "benchmarks/four_bar_runs.rs"]
+mod four_bar_runs;
