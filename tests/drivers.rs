@@ -312,7 +312,7 @@ impl Observer for NodeRec<'_> {
 fn bad_drivers_are_located_deck_errors() {
     let head = "NODES\n 1 0 0 0 FIX ALL\n 2 1 0 0\n 3 0 1 0 FIX X\nFUNCTIONS\n 1 HAVERSINE 0 1\n 2 TABLE 0 0 1 1\n 3 CONSTANT 0.5\nELEMENTS\n";
     let tail = "\nANALYSIS DYNAMIC STEP 1e-3 END 1\n";
-    let cases: [(&str, usize, usize, &str); 10] = [
+    let cases: [(&str, usize, usize, &str); 12] = [
         (
             " 1 UJOINT 1 2 AXIS1 0 0 1 AXIS2 0 1 0 DRIVE 1",
             10,
@@ -352,6 +352,20 @@ fn bad_drivers_are_located_deck_errors() {
             11,
             15,
             "already prescribes",
+        ),
+        // A driven joint and a PRESCRIBED node motion that set one motion twice (node 1
+        // is fixed): located at the PRESCRIBED card, whichever comes first.
+        (
+            " 1 PRESCRIBED 2 ROTATION AXIS 0 0 1 FUNCTION 1\n 2 HINGE 1 2 AXIS 0 0 1 DRIVE 1",
+            10,
+            2,
+            "two drivers would fight",
+        ),
+        (
+            " 1 PRISMATIC 1 2 AXIS 1 0 0 DRIVE 1\n 2 PRESCRIBED 2 Y FUNCTION 1",
+            11,
+            2,
+            "two drivers would fight",
         ),
     ];
     for (card, line, col, gist) in cases {

@@ -150,3 +150,89 @@ impl Builder<'_> {
         Ok((n, ElementKind::Prescribed { motion, drive }))
     }
 }
+
+impl Builder<'_> {
+    /// A driven HINGE or PRISMATIC and a `PRESCRIBED` node motion that set the same motion
+    /// twice: the drive fixes its joint's whole relative rotation (HINGE: two blocked
+    /// components and the driven angle) or relative translation (PRISMATIC); a
+    /// `PRESCRIBED` rotation (translation component) of one of its nodes, when the other
+    /// node's rotation (that component) is fixed or prescribed too, sets it again — the
+    /// two equations are redundant and, unless their laws agree exactly, contradictory.
+    /// Refused at the `PRESCRIBED` card (called once every element is read, so the cards'
+    /// order does not matter).
+    pub(super) fn check_drive_fights(&mut self) {
+        let mut errors = Vec::new();
+        let prescribed: Vec<(&Element, &NodeMotion)> = self
+            .elements
+            .values()
+            .filter_map(|e| match &e.kind {
+                ElementKind::Prescribed { motion, .. } => Some((e, motion)),
+                _ => None,
+            })
+            .collect();
+        // Is node `n`'s motion of the kind of `m` held by a fixity or another PRESCRIBED?
+        let held = |n: NodeId, m: &NodeMotion, not: ElementId| -> bool {
+            let fixed = self.nodes.get(&n).map_or([false; 6], |nd| nd.fixed);
+            match m {
+                NodeMotion::Rotation(_) => {
+                    fixed[3..6].iter().all(|&f| f)
+                        || prescribed.iter().any(|(e, mm)| {
+                            e.id != not && e.nodes[0] == n && matches!(mm, NodeMotion::Rotation(_))
+                        })
+                }
+                NodeMotion::Displacement(i) => {
+                    fixed[*i]
+                        || prescribed.iter().any(|(e, mm)| {
+                            e.id != not
+                                && e.nodes[0] == n
+                                && matches!(mm, NodeMotion::Displacement(j) if j == i)
+                        })
+                }
+            }
+        };
+        for (jid, _) in self.drives.iter() {
+            let Some(joint) = self.elements.get(jid) else {
+                continue;
+            };
+            let rotation = match joint.kind {
+                ElementKind::Hinge { .. } => true,
+                ElementKind::Prismatic { .. } => false,
+                _ => continue,
+            };
+            for (p, m) in &prescribed {
+                if matches!(m, NodeMotion::Rotation(_)) != rotation {
+                    continue;
+                }
+                let node = p.nodes[0];
+                let other = match joint.nodes.as_slice() {
+                    [a, b] if *a == node => *b,
+                    [a, b] if *b == node => *a,
+                    _ => continue,
+                };
+                if !held(other, m, p.id) {
+                    continue;
+                }
+                let what = if rotation { "rotation" } else { "translation" };
+                errors.push(DeckError::new(
+                    K::BadDrive {
+                        context: format!("element {} (PRESCRIBED)", p.id.0),
+                        reason: format!(
+                            "the driven {} {} (line {}) already sets the relative {what} of \
+                             nodes {} and {}, and node {}'s {what} is fixed or prescribed: two \
+                             drivers would fight over one motion; drop the PRESCRIBED element \
+                             or the DRIVE",
+                            joint.kind.keyword(),
+                            jid.0,
+                            self.line(joint.span),
+                            joint.nodes[0].0,
+                            joint.nodes[1].0,
+                            other.0
+                        ),
+                    },
+                    p.span,
+                ));
+            }
+        }
+        self.errors.extend(errors);
+    }
+}

@@ -189,6 +189,7 @@ pub(crate) fn build_model(
         b.push(r);
     }
     b.resolve_hinges();
+    b.check_drive_fights();
     for c in of(Section::Loads) {
         let r = b.load(c);
         b.push(r);
