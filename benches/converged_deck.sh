@@ -7,11 +7,11 @@
 #
 #   benches/converged_deck.sh [OUT] [ROUNDS] [CANDIDATES...]
 #
-# A candidate is NAME:STEP:INTEGRATOR with INTEGRATOR one of hht, ga0.8, ga0.9, esdirk
-# (default: the list below). Each candidate runs once with output every step (for its
+# A candidate is NAME:STEP:INTEGRATOR[:EVERY] with INTEGRATOR one of hht, ga0.8, ga0.9,
+# esdirk (default: the list below). Each candidate runs once with output every step (for its
 # error: benches/converged_deck.py interpolates the reference at the run's instants) and
-# ROUNDS times with the deck's output interval, 1e-3 s (timed; STEP must divide 1e-3 s and
-# the END, 1.5 s). The reference is made once in OUT (as benches/esdirk_ratio.sh does) or
+# ROUNDS times with output every EVERY steps (timed; default: 1e-3 s, which STEP must then
+# divide; STEP must divide the END, 1.5 s). The reference is made once in OUT (as benches/esdirk_ratio.sh does) or
 # taken from OUT/out_ref. Needs a release build and python3 (standard library only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,7 +22,7 @@ cands=("$@")
 [ ${#cands[@]} -gt 0 ] || cands=(
   hht16:1.5625e-5:hht hht20:2e-5:hht hht25:2.5e-5:hht
   ga8_16:1.5625e-5:ga0.8 ga8_20:2e-5:ga0.8 ga8_25:2.5e-5:ga0.8
-  ga9_16:1.5625e-5:ga0.9 ga9_20:2e-5:ga0.9 ga9_25:2.5e-5:ga0.9
+  ga9_16:1.5625e-5:ga0.9 ga9_1875:1.875e-5:ga0.9:80 ga9_20:2e-5:ga0.9 ga9_25:2.5e-5:ga0.9
   es25:2.5e-5:esdirk es31:3.125e-5:esdirk es40:4e-5:esdirk
 )
 bin=target/release/mecano-rs
@@ -53,8 +53,8 @@ mk() { # name step integrator every suffix
 user() { /usr/bin/time -f %U "$@" 2>&1 >/dev/null | tail -1; }
 runs=()
 for c in "${cands[@]}"; do
-  IFS=: read -r name step integ <<<"$c"
-  every=$(python3 -c "import sys; k=1e-3/float(sys.argv[1]); assert abs(k-round(k))<1e-9, 'step must divide 1e-3 s'; print(round(k))" "$step")
+  IFS=: read -r name step integ every <<<"$c"
+  [ -n "$every" ] || every=$(python3 -c "import sys; k=1e-3/float(sys.argv[1]); assert abs(k-round(k))<1e-9, 'step must divide 1e-3 s'; print(round(k))" "$step")
   mk "$name" "$step" "$integ" 1 _dense
   mk "$name" "$step" "$integ" "$every" ""
   [ -f "$out/out_${name}_dense/summary.json" ] ||
@@ -65,7 +65,7 @@ python3 benches/converged_deck.py "$out/out_ref" "${runs[@]}"
 for r in $(seq 1 "$rounds"); do
   line="round $r:"
   for c in "${cands[@]}"; do
-    IFS=: read -r name _ _ <<<"$c"
+    IFS=: read -r name _ _ _ <<<"$c"
     line="$line $name $(user "$bin" "$out/$name.dat" -o "$out/out_$name" --quiet --checkpoint 0 --force)"
   done
   echo "$line (user CPU s)"
