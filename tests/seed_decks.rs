@@ -24,7 +24,7 @@ use common::{deck, deck_path};
 use mecano::deck::{load_deck, parse_deck, strip_spans};
 use mecano::model::{
     Analysis, Element, ElementId, ElementKind, Fixity, Function, Material, MaterialId, Model,
-    NodeId, Section, SectionId, Selection,
+    NodeId, Scheme, Section, SectionId, Selection,
 };
 use mecano::scenes::{PendulumSettings, pendulum_deck, pendulum_order_deck};
 use nalgebra::Vector3;
@@ -39,6 +39,8 @@ enum Diff {
     Step,
     /// The end time.
     End,
+    /// The time integrator (HHT, generalized-α, ESDIRK3) and its parameter.
+    Integrator,
     /// The output request.
     Output,
     /// The time function of the `k`-th load (deck order).
@@ -239,6 +241,7 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
         end,
         min_step,
         max_step,
+        scheme,
         ..
     } = &mut analysis
     {
@@ -247,6 +250,9 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
         }
         if has(Diff::End) {
             *end = 0.0;
+        }
+        if has(Diff::Integrator) {
+            *scheme = Scheme::Hht { alpha: 0.0 };
         }
     }
     let o = &m.output;
@@ -322,7 +328,7 @@ const DERIVED: &[(&str, &str, &[Diff])] = &[
     (
         "pendulum_converged.dat",
         "pendulum_flexible1.dat",
-        &[Mesh, Step, End, Output],
+        &[Mesh, Step, End, Output, Integrator],
     ),
     (
         "pendulum_converged_beams.dat",
@@ -357,7 +363,7 @@ fn the_clipped_converged_deck_is_caught() {
             "the old converged deck",
             &old,
             "pendulum_flexible1.dat",
-            &[Mesh, Step, End, Output],
+            &[Mesh, Step, End, Output, Integrator],
         )
     });
     assert!(r.is_err(), "the clipped contact law went unnoticed");

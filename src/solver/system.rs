@@ -413,6 +413,38 @@ impl System {
         info
     }
 
+    /// The constraint rows `s Φ(q)` alone (the multipliers' equations, `rhs[n_node_eq..]`),
+    /// from the elements that carry multipliers: what [`System::assemble`] puts there, bit for
+    /// bit (each multiplier row belongs to one element, so it receives one addition either
+    /// way), without evaluating the others (beams, contacts), whose rows these are not. The
+    /// nodal part of `rhs` is left as it was. For the ESDIRK stages' velocity-level rows,
+    /// which need `Φ` at two moved states per Newton iteration.
+    pub fn assemble_constraint_rows(
+        &mut self,
+        ctx: &EvalContext,
+        nodes: &[NodeState],
+        lambda: &[f64],
+    ) {
+        let nn = self.n_node_eq;
+        self.rhs[nn..].iter_mut().for_each(|v| *v = 0.0);
+        for (e, el) in self.elements.iter().enumerate() {
+            let k = el.multipliers();
+            if k == 0 {
+                continue;
+            }
+            let local = &mut self.locals[self.local_of[e] as usize];
+            local.res.fill(0.0);
+            let o = self.mult_offset[e];
+            el.evaluate(ctx, nodes, &lambda[o..o + k], false, local);
+            let first = 6 * el.nodes().len();
+            for (i, &g) in self.rows[e].iter().enumerate().skip(first) {
+                if g != NONE {
+                    self.rhs[g as usize] += local.res[i];
+                }
+            }
+        }
+    }
+
     /// Power of the applied loads at `t`, W (forces on velocities, moments on global
     /// angular velocities).
     pub fn external_power(&self, t: f64, nodes: &[NodeState]) -> f64 {

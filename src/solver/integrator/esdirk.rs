@@ -252,11 +252,14 @@ impl Integrator {
             t: ctx.t + dt,
             ..*ctx
         };
+        // The constraint rows alone: the elements without multipliers (beams, contacts)
+        // are not evaluated at the moved states (and a contact's per-attempt memory is not
+        // touched by evaluations at other times).
         self.sys
-            .assemble(&at(eps), &st.plus, &self.trial_lambda, false);
+            .assemble_constraint_rows(&at(eps), &st.plus, &self.trial_lambda);
         st.rows.copy_from_slice(&self.sys.rhs[nn..]);
         self.sys
-            .assemble(&at(-eps), &st.minus, &self.trial_lambda, false);
+            .assemble_constraint_rows(&at(-eps), &st.minus, &self.trial_lambda);
         let c = st.gh / (2.0 * eps);
         for (r, m) in st.rows.iter_mut().zip(&self.sys.rhs[nn..]) {
             *r = (*r - m) * c;
