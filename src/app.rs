@@ -491,7 +491,11 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
     // `ANALYSIS MODES n`: the modal analysis of `mecano-rs modes DECK --count n` about the
     // initial state, written into the run's directory (no time run, no checkpoint).
     if let Some(n) = model.modes {
-        let about = modes::About::Initial;
+        let about = if model.modes_rotating {
+            modes::About::Rotating
+        } else {
+            modes::About::Initial
+        };
         return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
     }
     let what = path.display().to_string();

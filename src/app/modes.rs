@@ -13,6 +13,7 @@ pub use crate::modes::about::{
     lowest_about_initial, reach_state,
 };
 use crate::modes::output::{self, DeckStep};
+use crate::modes::rotating::{Frame, FrameError};
 use crate::modes::vtk as modes_vtk;
 use crate::modes::{ModalAnalysis, Solver};
 use crate::solver;
@@ -37,6 +38,11 @@ pub struct ModesArgs {
     /// Run the deck to time T (≤ its END) and linearise about the state reached.
     #[arg(long, value_name = "T")]
     pub at: Option<f64>,
+    /// A hub driven at constant speed (the deck's one `HINGE … DRIVE f`, grounded, with
+    /// `a f̈ = 0` at t = 0): linearise about the relative equilibrium, the modes seen in the
+    /// frame turning with the hub (docs/modes.md, "Rotating structures").
+    #[arg(long, conflicts_with_all = ["at", "statics"])]
+    pub rotating: bool,
     /// Output directory (default: out/<deck name>/modes).
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -201,6 +207,29 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
     }
 }
 
+/// The frame error with the deck's path and, when it has a place, its line and column.
+fn located(deck: &Path, e: &FrameError) -> String {
+    let span = match e {
+        FrameError::OtherDriver { span, .. }
+        | FrameError::NotGrounded { span, .. }
+        | FrameError::NotConstant { span, .. } => Some(*span),
+        _ => None,
+    };
+    let text = std::fs::read_to_string(deck).unwrap_or_default();
+    match span.filter(|s| s.start <= text.len() && text.is_char_boundary(s.start)) {
+        Some(s) => {
+            let before = &text[..s.start];
+            let line = before.matches('\n').count() + 1;
+            let col = before[before.rfind('\n').map_or(0, |p| p + 1)..]
+                .chars()
+                .count()
+                + 1;
+            format!("{}:{line}:{col}: --rotating: {e}", deck.display())
+        }
+        None => format!("{}: --rotating: {e}", deck.display()),
+    }
+}
+
 fn out_dir(args: &ModesArgs, model: &Model) -> PathBuf {
     args.out
         .clone()
@@ -235,6 +264,7 @@ pub fn run(args: &ModesArgs) -> u8 {
         Err(code) => return code,
     };
     let about = match (args.statics, args.at) {
+        _ if args.rotating || model.modes_rotating => About::Rotating,
         (true, _) => About::Static,
         (false, Some(t)) => About::At(t),
         (false, None) => About::Initial,
@@ -275,6 +305,12 @@ fn run_loaded_using(
     quiet: bool,
     solver: Solver,
 ) -> u8 {
+    if about == About::Rotating
+        && let Err(e) = Frame::from_model(model, 0.0)
+    {
+        eprintln!("error: {}", located(deck, &e));
+        return EXIT_BAD_INPUT;
+    }
     let (integ, a) = match analyse_model_using(model, about, count, solver) {
         Ok(r) => r,
         Err(f) => {
@@ -290,10 +326,22 @@ fn run_loaded_using(
         About::Initial => "initial".to_string(),
         About::Static => "static equilibrium".to_string(),
         About::At(t) => format!("run to t = {t} s"),
+        About::Rotating => "relative equilibrium (rotating frame)".to_string(),
     };
     let step = deck_step(model);
     let mut summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
     summary["vtk"] = modes_vtk::summary(&integ.sys, &a);
+    if about == About::Rotating
+        && let Ok(f) = Frame::from_model(model, integ.t)
+    {
+        summary["frame"] = serde_json::json!({
+            "kind": "rotating",
+            "hinge": f.element.to_string(),
+            "speed_rad_s": f.speed,
+            "axis": [f.axis.x, f.axis.y, f.axis.z],
+            "point": [f.point.x, f.point.y, f.point.z],
+        });
+    }
     let written = output::write_all(
         dir,
         &a,

@@ -464,6 +464,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "modal analysis: the lowest n modes about the initial state",
     ),
     kw(
+        "ROTATING",
+        "ANALYSIS",
+        "after MODES n: about the relative equilibrium of a hub driven at constant speed, modes in the rotating frame",
+    ),
+    kw(
         "ALPHA",
         "ANALYSIS",
         "HHT alpha (-1/3 <= alpha <= 0, default -0.1)",

@@ -376,7 +376,12 @@ pub fn write_deck(model: &Model) -> String {
         // `ANALYSIS MODES n` parses to the default static analysis of one step: the card
         // alone gives the model back.
         (_, Some(n)) => {
-            let _ = writeln!(s, "ANALYSIS MODES {n}");
+            let rot = if model.modes_rotating {
+                " ROTATING"
+            } else {
+                ""
+            };
+            let _ = writeln!(s, "ANALYSIS MODES {n}{rot}");
         }
         (
             Analysis::Dynamic {

@@ -423,6 +423,10 @@ pub struct Model {
     /// default Newton settings (what `modes --static` solves). `None`: the deck runs its
     /// `analysis`.
     pub modes: Option<u32>,
+    /// `ANALYSIS MODES n ROTATING`: the modes about the relative equilibrium of the deck's
+    /// hub driven at constant speed, seen in the rotating frame (as `mecano-rs modes
+    /// --rotating`; [`crate::modes::rotating`]).
+    pub modes_rotating: bool,
     /// Output requests.
     pub output: OutputRequest,
     /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the

@@ -3,6 +3,7 @@
 //! summary and `mecano-rs modes` share.
 
 use super::output::DeckStep;
+use super::rotating::{Frame, relative_equilibrium};
 use super::{ModalAnalysis, ModesError, Solver};
 use crate::model::{Analysis, Model};
 use crate::solver::{self, Integrator, Observer, Snapshot};
@@ -16,6 +17,9 @@ pub enum About {
     Static,
     /// The state a dynamic run reaches at this time.
     At(f64),
+    /// The relative equilibrium of a hub driven at constant speed, at t = 0; the modes
+    /// are those seen in the rotating frame ([`super::rotating`]).
+    Rotating,
 }
 
 /// A failure to reach the state or to solve: bad input (the command exits 2) or a failed
@@ -63,6 +67,22 @@ fn reach_state_with(model: &Model, about: About, warn: bool) -> Result<Integrato
     let mut m = model.clone();
     match about {
         About::Initial => {}
+        About::Rotating => {
+            // The deck's own analysis is not run: the state is the relative equilibrium.
+            let frame = Frame::from_model(model, 0.0).map_err(|e| bad(e.to_string()))?;
+            let mut integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
+            let (t, scale) = (integ.t, integ.scale);
+            relative_equilibrium(
+                &mut integ.sys,
+                &frame,
+                &mut integ.nodes,
+                &mut integ.lambda,
+                scale,
+                t,
+            )
+            .map_err(|e| failed(format!("the rotating state: {e}")))?;
+            return Ok(integ);
+        }
         About::Static => m.analysis = Analysis::Static { steps: 1, newton },
         About::At(t) => match &mut m.analysis {
             Analysis::Dynamic { end, .. } => {
@@ -133,19 +153,34 @@ fn analyse_model_with(
 ) -> Result<(Integrator, ModalAnalysis), Failed> {
     let mut integ = reach_state_with(model, about, warn)?;
     let groups: Vec<&str> = model.elements.values().map(|e| e.kind.keyword()).collect();
-    let a = crate::modes::analyse(
-        &mut integ.sys,
-        &integ.nodes,
-        &integ.lambda,
-        integ.scale,
-        integ.t,
-        &groups,
-        count,
-        solver,
-    )
+    let a = if about == About::Rotating {
+        let frame = Frame::from_model(model, integ.t).map_err(|e| bad(e.to_string()))?;
+        crate::modes::analyse_rotating(
+            &integ.sys,
+            &frame,
+            &integ.nodes,
+            &integ.lambda,
+            integ.scale,
+            integ.t,
+            &groups,
+            count,
+        )
+    } else {
+        crate::modes::analyse(
+            &mut integ.sys,
+            &integ.nodes,
+            &integ.lambda,
+            integ.scale,
+            integ.t,
+            &groups,
+            count,
+            solver,
+        )
+    }
     .map_err(|e| match e {
         ModesError::Dense(d) => failed(d.to_string()),
         ModesError::Sparse(d) => failed(d.to_string()),
+        ModesError::Equilibrium(d) => failed(d.to_string()),
         other => bad(other.to_string()),
     })?;
     Ok((integ, a))

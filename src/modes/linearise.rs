@@ -28,6 +28,9 @@ pub struct Linearised {
     pub m: DMatrix<f64>,
     /// Constraint Jacobian `B` (rows: multiplier equations; columns: nodal equations).
     pub b: DMatrix<f64>,
+    /// `∂r/∂λ̂` on the nodal equations (columns: the scaled multipliers), `s Bᵀ` for the
+    /// joints: the Newton matrix of a relative equilibrium ([`super::rotating`]) needs it.
+    pub kl: DMatrix<f64>,
     /// Per element: its local-to-nodal-equation map (`None` = fixed or multiplier) and its
     /// local stiffness and mass (column-major, size `6·nodes`), for energy shares.
     pub locals: Vec<ElementMatrices>,
@@ -110,7 +113,15 @@ pub fn linearise(
     }
     let k = full_k.view((0, 0), (nn, nn)).into_owned();
     let b = full_k.view((nn, 0), (n - nn, nn)).into_owned() / scale;
-    Linearised { k, c, m, b, locals }
+    let kl = full_k.view((0, nn), (nn, n - nn)).into_owned();
+    Linearised {
+        k,
+        c,
+        m,
+        b,
+        kl,
+        locals,
+    }
 }
 
 /// One element's linearisation at the state: its equation map (nodal dofs, then its

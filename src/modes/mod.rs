@@ -16,6 +16,7 @@ pub mod dense;
 pub mod hht;
 pub mod linearise;
 pub mod output;
+pub mod rotating;
 pub mod run_summary;
 pub mod sparse;
 pub mod vtk;
@@ -125,6 +126,9 @@ pub enum ModesError {
     /// The sparse solve failed.
     #[error(transparent)]
     Sparse(#[from] sparse::SparseError),
+    /// The relative equilibrium of a rotating model was not found.
+    #[error(transparent)]
+    Equilibrium(#[from] rotating::EquilibriumError),
 }
 
 /// Nodal unknowns from which [`analyse`] takes the sparse solver ([`sparse`]) for a
@@ -262,6 +266,26 @@ fn analyse_sparse(
     })
 }
 
+/// The lowest `count` modes of a steadily rotating model seen in its rotating frame
+/// ([`rotating`]): `nodes` and `lambda` must hold the relative equilibrium
+/// ([`rotating::relative_equilibrium`]); the rotating-frame matrices
+/// ([`rotating::to_rotating`]) are solved densely (gyroscopic: the first-order form).
+#[allow(clippy::too_many_arguments)]
+pub fn analyse_rotating(
+    sys: &System,
+    frame: &rotating::Frame,
+    nodes: &[NodeState],
+    lambda: &[f64],
+    scale: f64,
+    t: f64,
+    groups: &[&str],
+    count: usize,
+) -> Result<ModalAnalysis, ModesError> {
+    let lin = linearise::linearise(sys, nodes, lambda, scale, t);
+    let rel = rotating::to_rotating(sys, frame, nodes, &lin);
+    solve_dense(rel, sys.n_node_eq, groups, count)
+}
+
 fn analyse_dense(
     sys: &System,
     nodes: &[NodeState],
@@ -272,7 +296,15 @@ fn analyse_dense(
     count: usize,
 ) -> Result<ModalAnalysis, ModesError> {
     let lin = linearise::linearise(sys, nodes, lambda, scale, t);
-    let nn = sys.n_node_eq;
+    solve_dense(lin, sys.n_node_eq, groups, count)
+}
+
+fn solve_dense(
+    lin: linearise::Linearised,
+    nn: usize,
+    groups: &[&str],
+    count: usize,
+) -> Result<ModalAnalysis, ModesError> {
     let basis = linearise::null_space(&lin.b, nn);
     let free = basis.ncols();
     if free == 0 {
@@ -332,6 +364,24 @@ fn analyse_dense(
     // Rigid first, unstable next, then by ω².
     let mut order: Vec<&dense::RawMode> = raw.iter().collect();
     order.sort_by_key(|r| u8::from(!is_zero(r)));
+    // Undamped gyroscopic (`C` skew, `K` symmetric — a rotating frame's Coriolis matrix):
+    // the eigenvalues of a stable model are imaginary, and a real part is the first-order
+    // form's round-off, `ε ‖A‖ κ ≈ ε ω²_max (1 + |s|²)/(2|s|)` (‖A‖ ≈ ω²_max in
+    // mass-orthonormal coordinates, κ the condition of the pair `(φ, sφ)`), ×ZERO_FACTOR:
+    // below it it is reported as zero, neither damping nor instability.
+    let skew_c = state_space
+        && asymmetry <= ASYMMETRY_TOL
+        && max_abs(&(&cr + cr.transpose()))
+            <= DAMPED_TOL * (kn.max(f64::MIN_POSITIVE) * max_abs(&mr)).sqrt();
+    let clean = |s: (f64, f64)| {
+        let a = s.0.hypot(s.1);
+        let noise = dense::ZERO_FACTOR * f64::EPSILON * w2max * (1.0 + a * a) / (2.0 * a);
+        if skew_c && a > 0.0 && s.0.abs() <= noise {
+            (0.0, s.1)
+        } else {
+            s
+        }
+    };
     let (group_names, group_of) = group_index(groups);
     let modes = order
         .into_iter()
@@ -341,7 +391,7 @@ fn analyse_dense(
             let phi = phi.iter().copied().collect();
             make_mode_s(
                 phi,
-                r.s,
+                clean(r.s),
                 is_zero(r),
                 &lin.locals,
                 &group_of,

@@ -204,7 +204,11 @@ fn run_fresh(
         // modes the `mode` quantities read), as `mecano-rs DECK` makes it.
         Ok(model) if model.modes.is_some() => {
             let n = model.modes.unwrap_or(1) as usize;
-            let about = app::modes::About::Initial;
+            let about = if model.modes_rotating {
+                app::modes::About::Rotating
+            } else {
+                app::modes::About::Initial
+            };
             match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true) {
                 app::EXIT_OK => Ok(crate::solver::RunReport {
                     stats: Default::default(),

@@ -119,6 +119,8 @@ impl Builder<'_> {
             if n < 1 {
                 return Err(out_of_range("MODES", "0", ">= 1", s));
             }
+            // `ROTATING`: about the relative equilibrium of a hub driven at constant speed.
+            let rotating = c.keyword(&["ROTATING"]).is_some();
             c.finish()?;
             let analysis = Analysis::Static {
                 steps: 1,
@@ -126,6 +128,7 @@ impl Builder<'_> {
             };
             self.set_analysis(analysis, span)?;
             self.modes = Some(n);
+            self.modes_rotating = rotating;
             return Ok(());
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {

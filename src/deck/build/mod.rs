@@ -56,6 +56,8 @@ struct Builder<'s> {
     analysis: Option<(Analysis, Span)>,
     /// `ANALYSIS MODES n`.
     modes: Option<u32>,
+    /// `ANALYSIS MODES n ROTATING`.
+    modes_rotating: bool,
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
@@ -151,6 +153,7 @@ pub(crate) fn build_model(
         initial: Vec::new(),
         analysis: None,
         modes: None,
+        modes_rotating: false,
         output: None,
         divide: Vec::new(),
         hinge_refs: Vec::new(),
@@ -236,6 +239,7 @@ pub(crate) fn build_model(
         initial: b.initial,
         analysis,
         modes: b.modes,
+        modes_rotating: b.modes_rotating,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
         parameters: b.parameters,
