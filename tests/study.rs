@@ -292,5 +292,15 @@ fn order_study_shows_errors_falling_faster_than_mesh_refinement() {
             "{err}"
         );
     }
+    // A space–time study takes one integrator: two are refused (exit 2, nothing run) with a
+    // message naming them, not the "--adaptive" one (none was given).
+    let out = study(&["--order", "1,2", "--integrator", "hht,esdirk3"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("runs one integrator, got 2 (hht:-0.1, esdirk3)")
+            && !err.contains("--adaptive"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

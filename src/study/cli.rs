@@ -22,8 +22,11 @@ pub struct StudyArgs {
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub alpha: Vec<f64>,
     /// Time integrators of the fixed-step runs, comma-separated, one ladder of steps and one
-    /// line of the diagram each: `hht[:α]`, `genalpha[:ρ∞]` (default: the deck's). The first
-    /// one's finest run is the reference and its scheme the adaptive runs'.
+    /// line of the diagram each: `hht[:α]`, `genalpha[:ρ∞]`, `esdirk3` (default: the deck's).
+    /// A bare `hht` is α = −0.1 and a bare `genalpha` ρ∞ = 0.8; give another value after a
+    /// colon, e.g. `hht:-0.3,genalpha:0.5`. The first one's finest run is the reference and
+    /// its scheme the adaptive runs'. A space–time study (several `--refine`, or `--order`)
+    /// takes one.
     #[arg(long, value_delimiter = ',', value_parser = parse_scheme)]
     pub integrator: Vec<Scheme>,
     /// Nodes whose histories are compared (default: the deck's OUTPUT nodes).
@@ -148,10 +151,23 @@ pub fn run(args: &StudyArgs) -> u8 {
 /// The space–time study (`--refine` with several factors, or `--order`).
 fn run_space(args: &StudyArgs, steps: Vec<f64>, nodes: Vec<u32>, out_dir: PathBuf) -> u8 {
     let schemes = args.schemes();
-    if !args.adaptive.is_empty() || schemes.len() > 1 {
+    // One integrator per space–time study: its reference is the finest (mesh, step) pair of
+    // that integrator, and its table separates space from time errors for it alone; a
+    // comparison of integrators is the time study's (one ladder each, on one mesh).
+    if !args.adaptive.is_empty() {
         eprintln!(
-            "error: {}: a space-time study (several --refine factors, or --order) runs fixed steps with one integrator (the deck's, or one --integrator / --alpha): drop --adaptive and the others",
+            "error: {}: a space-time study (several --refine factors, or --order) runs fixed steps only: drop --adaptive",
             args.deck.display()
+        );
+        return crate::app::EXIT_BAD_INPUT;
+    }
+    if schemes.len() > 1 {
+        let names: Vec<String> = schemes.iter().map(|s| s.label()).collect();
+        eprintln!(
+            "error: {}: a space-time study (several --refine factors, or --order) runs one integrator, got {} ({}): run it once per integrator (with its own -o DIR), or compare the integrators with a time study (one --refine factor)",
+            args.deck.display(),
+            schemes.len(),
+            names.join(", ")
         );
         return crate::app::EXIT_BAD_INPUT;
     }
