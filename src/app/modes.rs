@@ -198,7 +198,11 @@ pub fn print_integrators(out: &mut dyn std::io::Write, a: &ModalAnalysis, st: De
         let _ = writeln!(out, "{line}");
     }
     if a.highest_hz.is_nan() {
-        let _ = writeln!(out, "  highest frequency not computed ({:?} solve)", a.method);
+        let _ = writeln!(
+            out,
+            "  highest frequency not computed ({:?} solve)",
+            a.method
+        );
     }
 }
 

@@ -357,9 +357,7 @@ fn analyse_dense(
     // neither damped nor unstable (the heavy top's ζ = −1.9e-15 at |s| = 4.75 1/s; the
     // pendulum at 0.05 s: ζ = −2.6e-6 at |s| = 5.7 1/s with ω²_max = 9.4e10 1/s²).
     let re_tol = if method == Method::StateSpace {
-        let a_norm = 1f64
-            .max(stiffness_scale)
-            .max(model_scale(&lin.c, &lin.m));
+        let a_norm = 1f64.max(stiffness_scale).max(model_scale(&lin.c, &lin.m));
         dense::ZERO_FACTOR * f64::EPSILON * a_norm
     } else {
         0.0
