@@ -694,3 +694,178 @@ fn rotating_deck_through_the_cli_states_its_frame() {
     );
     let _ = std::fs::remove_dir_all(&base);
 }
+
+/// Review of the modes command (round-off signs): the heavy top spinning about its
+/// initial state is gyroscopic (state-space solve); its precession-like mode's computed
+/// `Re s` was −9e-15 1/s (ζ = −1.9e-15), far below the solver's round-off
+/// `10 ε ‖A‖ (1 + |s|²)/(2|s|)` ≈ 8e-13 1/s (src/modes/mod.rs): it is neither damped nor
+/// unstable, and its damping ratio is +0 (not −0).
+#[test]
+fn heavy_top_has_no_round_off_unstable_mode() {
+    let model = load(&deck("heavy_top.dat"), &[], 1, None).unwrap();
+    let a = modes(&model, About::Initial, 3);
+    let z: Vec<(ModeKind, f64, f64)> = a
+        .modes
+        .iter()
+        .map(|m| (m.kind, m.natural_hz, m.damping_ratio))
+        .collect();
+    eprintln!("heavy top: {z:?}");
+    assert!(
+        a.modes.iter().all(|m| m.kind != ModeKind::Unstable),
+        "{z:?}"
+    );
+    assert!(a.modes.iter().any(|m| m.kind == ModeKind::Elastic), "{z:?}");
+    for m in &a.modes {
+        assert!(
+            m.damping_ratio == 0.0 && m.damping_ratio.is_sign_positive(),
+            "{z:?}"
+        );
+    }
+}
+
+/// The simple pendulum (decks/simple_pendulum.dat: 1 kg at the end of a 1 m massless link,
+/// released with the link horizontal): about that state gravity gives no restoring moment
+/// (`∂(m g L cos θ)/∂θ = 0` at θ = 90° from the vertical), so its one mode is a zero, not a
+/// round-off frequency of 2e-13 Hz called unstable with ζ = −1. Hanging (node 2 moved below
+/// the pivot), its mode is `ω² = g/L`: f = √9.81 / 2π = 0.498488 Hz, to the Rayleigh
+/// quotient's round-off (1e-12 relative; 1e-9 asserted).
+#[test]
+fn simple_pendulum_single_mode_is_a_zero_or_its_closed_form() {
+    let model = load(&deck("simple_pendulum.dat"), &[], 1, None).unwrap();
+    let a = modes(&model, About::Initial, 1);
+    eprintln!(
+        "simple pendulum, horizontal: {:?}, highest {} Hz",
+        a.modes
+            .iter()
+            .map(|m| (m.kind, m.natural_hz, m.damping_ratio))
+            .collect::<Vec<_>>(),
+        a.highest_hz
+    );
+    assert_eq!(a.modes.len(), 1);
+    assert_eq!(a.modes[0].kind, ModeKind::Rigid);
+    assert_eq!(a.rigid_modes, 1);
+    assert_eq!(a.highest_hz, 0.0, "no finite frequency");
+    // Hanging.
+    let text = std::fs::read_to_string(deck("simple_pendulum.dat")).unwrap();
+    assert!(text.contains("\n  2  1 0 0\n"));
+    let hanging = model_from(&text.replace("\n  2  1 0 0\n", "\n  2  0 -1 0\n"));
+    let a = modes(&hanging, About::Initial, 1);
+    let exact = 9.81f64.sqrt() / (2.0 * PI);
+    eprintln!(
+        "simple pendulum, hanging: {} Hz (exact {exact}), kind {:?}, ζ {}",
+        a.modes[0].natural_hz, a.modes[0].kind, a.modes[0].damping_ratio
+    );
+    assert_eq!(a.modes[0].kind, ModeKind::Elastic);
+    assert!((a.modes[0].natural_hz - exact).abs() <= 1e-9 * exact);
+    assert_eq!(a.rigid_modes, 0);
+}
+
+/// A model without mass refuses any count as "nothing to vibrate", not as too many modes
+/// of a made-up finite count: the simple pendulum without its MASS.
+#[test]
+fn massless_model_is_refused_before_the_count() {
+    let text = std::fs::read_to_string(deck("simple_pendulum.dat")).unwrap();
+    assert!(text.contains("  2  MASS 2 M 1\n"));
+    let model = model_from(&text.replace("  2  MASS 2 M 1\n", ""));
+    let err = analyse_model(&model, About::Initial, 10)
+        .map(|_| ())
+        .expect_err("no mass");
+    eprintln!("massless: {}", err.message);
+    assert!(err.message.contains("no mass"), "{}", err.message);
+}
+
+/// ESDIRK3 (Kennedy & Carpenter ESDIRK3(2)4L[2]SA, order p = 3, L-stable) on the
+/// undamped oscillator: `R(iθ) = e^{iθ} + c₄(iθ)⁴ + c₅(iθ)⁵ + …`. The real θ⁴ term changes
+/// the modulus, `|R| − 1 = c₄θ⁴ + O(θ⁶)`, so `ξ̄ = −ln|R|/arg R = −c₄θ³(1 + O(θ²))`; the
+/// phase moves at `O(θ⁵)`, so the period error `θ/arg R − 1 = O(θ⁴)`. Halving θ therefore
+/// divides ξ̄ by 8 and the period error by 16, to relative O(θ²) = 1e-4 at θ = 1e-2
+/// (1e-3 asserted: the O(θ²) coefficient is a ratio of error constants; round-off: R
+/// carries ε, so arg R carries ε and the period error ε/θ = 2e-14 against its 1.5e-10
+/// at θ = 1e-2 (c₅ − c₄ ≈ 0.015 measured on the cantilever's rows): 1.5e-4 relative;
+/// ξ̄'s |R| − 1 ≈ 2.6e-10 carries ε: 1e-6 relative). L-stable and stiffly accurate:
+/// `R(z) = O(1/z)` as `z → ∞`, so the radius falls by 1e3 from Ω = 1e3 to 1e6 (1 %
+/// tolerance for the O(1/z²) term) and is below 1e-5 at 1e6.
+#[test]
+fn esdirk3_spectral_properties_match_its_order_and_l_stability() {
+    use mecano::model::Scheme;
+    use mecano::modes::hht::spectral;
+    let e = Scheme::Esdirk3;
+    let (a1, a2) = (spectral(&e, 2e-2), spectral(&e, 1e-2));
+    let (rd, rp) = (a1.damping / a2.damping, a1.period_error / a2.period_error);
+    eprintln!("ESDIRK3 Ω = 1e-2: {a2:?}; ratios: damping {rd}, period {rp}");
+    assert!(a2.damping > 0.0, "dissipative: {a2:?}");
+    assert!((rd - 8.0).abs() < 8e-3, "damping ratio {rd}");
+    assert!((rp - 16.0).abs() < 16e-3, "period ratio {rp}");
+    let (r3, r6) = (spectral(&e, 1e3).radius, spectral(&e, 1e6).radius);
+    eprintln!("ESDIRK3 radius: Ω = 1e3 {r3:e}, Ω = 1e6 {r6:e}");
+    assert!((r3 / r6 / 1e3 - 1.0).abs() < 1e-2, "{r3} {r6}");
+    assert!(r6 < 1e-5);
+    // The comparison of `--check` lists three schemes whatever the deck's.
+    for deck in [
+        Scheme::Esdirk3,
+        Scheme::default(),
+        Scheme::GeneralizedAlpha { rho_inf: 0.3 },
+    ] {
+        let v = mecano::modes::hht::compared_schemes(&deck);
+        let mut names: Vec<&str> = v.iter().map(|s| s.name()).collect();
+        assert_eq!(v[0], deck);
+        names.sort_unstable();
+        assert_eq!(names, ["esdirk3", "genalpha", "hht"], "{v:?}");
+    }
+}
+
+/// `--check` on an ESDIRK3 deck compares HHT and generalized-α too and names the highest
+/// mode, which ESDIRK3 annihilates (|R| ≤ 0.1 per step), "annihilated"; the sparse path
+/// (`--order 1 --refine 64`, 390 unknowns) does not call its last computed mode "highest".
+#[test]
+fn check_compares_three_integrators_and_sparse_does_not_invent_the_highest() {
+    let base = common::TempDir::new("modes_review");
+    let _ = std::fs::remove_dir_all(&base);
+    std::fs::create_dir_all(&base).unwrap();
+    let original = std::fs::read_to_string(deck("cantilever_modes.dat")).unwrap();
+    let dynamic = "ANALYSIS DYNAMIC ALPHA 0 STEP 2e-4 END 0.3";
+    assert!(original.contains(dynamic));
+    let p = base.join("esdirk.dat");
+    std::fs::write(
+        &p,
+        original.replace(dynamic, "ANALYSIS DYNAMIC ESDIRK3 STEP 2e-4 END 0.3"),
+    )
+    .unwrap();
+    let out = mecano(&["--check", p.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{text}");
+    let table = text
+        .split("what each integrator does")
+        .nth(1)
+        .expect("comparison table");
+    let head = table.lines().nth(1).unwrap();
+    for s in ["esdirk3", "hht:-0.1", "genalpha:0.8182"] {
+        assert!(head.contains(s), "{head}");
+    }
+    let last = table
+        .lines()
+        .find(|l| l.ends_with("highest"))
+        .expect("highest row");
+    assert!(last.contains("annihilated"), "{last}");
+    assert!(!table.contains("0.000e0 unresolved"), "{table}");
+    // Sparse: no "highest" row, a line saying it was not computed.
+    let out = mecano(&[
+        "modes",
+        deck("cantilever_modes.dat").to_str().unwrap(),
+        "--order",
+        "1",
+        "--refine",
+        "64",
+        "--count",
+        "4",
+        "-o",
+        base.join("sparse").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{text}");
+    assert!(text.contains("SparseSymmetric"), "{text}");
+    assert!(!text.lines().any(|l| l.ends_with("highest")), "{text}");
+    assert!(text.contains("highest frequency not computed"), "{text}");
+    let _ = std::fs::remove_dir_all(&base);
+}

@@ -116,18 +116,46 @@ pub fn print_table(out: &mut dyn std::io::Write, a: &ModalAnalysis, step: Option
         );
         let rows = output::step_resolution(a, st);
         for (i, r) in rows.iter().enumerate() {
-            let label = if i + 1 == rows.len() { "highest" } else { "" };
+            let label = if i + 1 == rows.len() && highest_computed(a) {
+                "highest"
+            } else {
+                ""
+            };
+            let (damping, period) = resolution_cells(r);
             let _ = writeln!(
                 out,
-                "  {:12.6e}  {:10.3e}  {:10.3e}  {:>10}  {label}",
-                r.frequency_hz,
-                r.samples_per_period,
-                r.hht_damping,
-                r.period_error
-                    .map_or("unresolved".to_string(), |e| format!("{e:.3e}"))
+                "  {:12.6e}  {:10.3e}  {damping:>11}  {period:>10}  {label}",
+                r.frequency_hz, r.samples_per_period,
+            );
+        }
+        if a.highest_hz.is_nan() {
+            let _ = writeln!(
+                out,
+                "  highest frequency not computed ({:?} solve: the lowest modes only)",
+                a.method
             );
         }
     }
+}
+
+/// The step-resolution table's last row is the mesh's highest frequency (the dense solve
+/// computed it, and it is not zero); the sparse solve leaves it NaN.
+fn highest_computed(a: &ModalAnalysis) -> bool {
+    a.highest_hz.is_finite() && a.highest_hz > 0.0
+}
+
+/// A row's damping ratio and period error as printed: "annihilated" when the step leaves
+/// at most [`crate::modes::hht::ANNIHILATED_RADIUS`] of the mode, "unresolved" for a period
+/// the step does not resolve.
+fn resolution_cells(r: &crate::modes::hht::Resolution) -> (String, String) {
+    if r.annihilated() {
+        return ("annihilated".to_string(), "-".to_string());
+    }
+    (
+        format!("{:.3e}", r.hht_damping),
+        r.period_error
+            .map_or("unresolved".to_string(), |e| format!("{e:.3e}")),
+    )
 }
 
 /// What each integrator does to each mode at the deck's step (issue 26 §4): the numerical
@@ -167,15 +195,20 @@ pub fn print_integrators(out: &mut dyn std::io::Write, a: &ModalAnalysis, st: De
     for (i, r) in tables[0].iter().enumerate() {
         let mut line = format!("  {:12.6e}", r.frequency_hz);
         for t in &tables {
-            let period = t[i]
-                .period_error
-                .map_or("unresolved".to_string(), |e| format!("{e:.3e}"));
-            let _ = write!(line, "  {:>11.3e} {:>11}", t[i].hht_damping, period);
+            let (damping, period) = resolution_cells(&t[i]);
+            let _ = write!(line, "  {damping:>11} {period:>11}");
         }
-        if i + 1 == tables[0].len() {
+        if i + 1 == tables[0].len() && highest_computed(a) {
             line.push_str("  highest");
         }
         let _ = writeln!(out, "{line}");
+    }
+    if a.highest_hz.is_nan() {
+        let _ = writeln!(
+            out,
+            "  highest frequency not computed ({:?} solve)",
+            a.method
+        );
     }
 }
 

@@ -73,7 +73,11 @@ pub fn spectral(scheme: &Scheme, omega_h: f64) -> Spectral {
             Spectral {
                 omega_h,
                 radius: z.norm(),
-                damping: if arg > 0.0 { -z.norm().ln() / arg } else { 0.0 },
+                damping: if arg > 0.0 {
+                    -z.norm().ln() / arg + 0.0
+                } else {
+                    0.0
+                },
                 period_error: if arg > 0.0 {
                     omega_h / arg - 1.0
                 } else {
@@ -101,7 +105,7 @@ fn principal_of(a: &Matrix3<f64>, omega_h: f64) -> Spectral {
             Spectral {
                 omega_h,
                 radius,
-                damping: -z.norm().ln() / arg,
+                damping: -z.norm().ln() / arg + 0.0,
                 period_error: omega_h / arg - 1.0,
             }
         }
@@ -127,6 +131,22 @@ pub struct Resolution {
     /// The scheme's relative period error at `ωh` (`None` when the step does not resolve the
     /// mode: the principal pair is real, or `ωh > π`).
     pub period_error: Option<f64>,
+    /// The scheme's spectral radius at `ωh`: the amplitude left of the mode after one step.
+    pub radius: f64,
+}
+
+/// Spectral radius at or below which a mode is reported "annihilated": the step leaves at
+/// most a tenth of it, so after 16 steps at most 1e-16, below round-off of the state; its
+/// damping ratio and period (of a pair that is real or past `ωh = π`) mean nothing. Reached
+/// by ESDIRK3 (`R(∞) = 0`, L-stable) and generalized-α of small `ρ∞`; never by HHT
+/// (`ρ∞ ≥ ½`).
+pub const ANNIHILATED_RADIUS: f64 = 0.1;
+
+impl Resolution {
+    /// The step leaves at most [`ANNIHILATED_RADIUS`] of the mode.
+    pub fn annihilated(&self) -> bool {
+        self.radius <= ANNIHILATED_RADIUS
+    }
 }
 
 /// The resolution of a mode of `frequency_hz` by `scheme` with step `h`.
@@ -138,26 +158,42 @@ pub fn resolution(scheme: &Scheme, h: f64, frequency_hz: f64) -> Resolution {
         samples_per_period: 1.0 / (frequency_hz * h),
         hht_damping: s.damping,
         period_error: s.period_error.is_finite().then_some(s.period_error),
+        radius: s.radius,
     }
 }
 
 /// The schemes whose action on each mode `--check` and a run's summary set side by side:
-/// the deck's first, then every other scheme at the deck's spectral radius at infinity
-/// `ρ∞` (the same damping of the unresolved modes, so that the rows differ in what they do
-/// to the resolved ones): generalized-α with that `ρ∞`, and HHT with
-/// `α = (ρ∞ − 1)/(ρ∞ + 1)` where that is in HHT's range (`ρ∞ ≥ ½`). A new scheme adds
-/// itself here.
+/// the deck's first, then each of HHT, generalized-α and ESDIRK3 that is not the deck's.
+/// HHT and generalized-α at the deck's spectral radius at infinity `ρ∞` where it is in
+/// their range (the same damping of the unresolved modes, so that the rows differ in what
+/// they do to the resolved ones): HHT with `α = (ρ∞ − 1)/(ρ∞ + 1)` when `ρ∞ ≥ ½`, else
+/// the default `α = −0.1`; generalized-α with the deck's `ρ∞`, or HHT's when the deck is
+/// ESDIRK3 (`ρ∞ = 0`). ESDIRK3 has no parameter.
 pub fn compared_schemes(deck: &Scheme) -> Vec<Scheme> {
-    let rho = deck.rho_inf();
+    let hht = match *deck {
+        Scheme::Hht { .. } => *deck,
+        _ => {
+            let rho = deck.rho_inf();
+            let alpha = (rho - 1.0) / (rho + 1.0);
+            if Scheme::alpha_ok(alpha) {
+                Scheme::Hht { alpha }
+            } else {
+                Scheme::default()
+            }
+        }
+    };
+    let ga = match *deck {
+        Scheme::GeneralizedAlpha { .. } => *deck,
+        Scheme::Hht { .. } => Scheme::GeneralizedAlpha {
+            rho_inf: deck.rho_inf(),
+        },
+        Scheme::Esdirk3 => Scheme::GeneralizedAlpha {
+            rho_inf: hht.rho_inf(),
+        },
+    };
     let mut v = vec![*deck];
-    let alpha = (rho - 1.0) / (rho + 1.0);
-    for s in [
-        Scheme::Hht { alpha },
-        Scheme::GeneralizedAlpha { rho_inf: rho },
-    ] {
-        // (No match on the variants: another scheme needs no arm here.)
-        let valid = s.hht_alpha().is_none_or(Scheme::alpha_ok) && Scheme::rho_inf_ok(s.rho_inf());
-        if valid && s.name() != deck.name() {
+    for s in [hht, ga, Scheme::Esdirk3] {
+        if s.name() != deck.name() {
             v.push(s);
         }
     }
@@ -224,7 +260,7 @@ mod tests {
                 },
                 Scheme::GeneralizedAlpha { rho_inf: rho },
             ];
-            assert_eq!(compared_schemes(&ga), vec![ga, hht]);
+            assert_eq!(compared_schemes(&ga), vec![ga, hht, Scheme::Esdirk3]);
             for w in [0.05, 0.2, 0.5] {
                 let (a, b) = (spectral(&hht, w), spectral(&ga, w));
                 assert!(b.damping < a.damping, "ρ∞ {rho}, Ω {w}: {b:?} vs {a:?}");
@@ -232,9 +268,12 @@ mod tests {
             assert!((spectral(&ga, 1e6).radius - rho).abs() < 1e-3);
             assert!((spectral(&hht, 1e6).radius - rho).abs() < 1e-9);
         }
-        // ρ∞ < ½ has no HHT counterpart.
+        // ρ∞ < ½ has no HHT counterpart: HHT's default α = −0.1.
         let ga = Scheme::GeneralizedAlpha { rho_inf: 0.2 };
-        assert_eq!(compared_schemes(&ga), vec![ga]);
+        assert_eq!(
+            compared_schemes(&ga),
+            vec![ga, Scheme::default(), Scheme::Esdirk3]
+        );
     }
 
     #[test]

@@ -166,6 +166,12 @@ fn max_abs(a: &DMatrix<f64>) -> f64 {
     a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
+/// `max|A| / max|M|`: the scale of `M⁻¹A` (0 without mass).
+fn model_scale(a: &DMatrix<f64>, m: &DMatrix<f64>) -> f64 {
+    let mn = max_abs(m);
+    if mn > 0.0 { max_abs(a) / mn } else { 0.0 }
+}
+
 /// The lowest `count` modes of `sys` linearised at the state (`nodes`, scaled multipliers
 /// `lambda`, constraint scale `scale`, time `t`); `groups[e]` names element `e`'s group.
 /// `solver` chooses dense or sparse ([`Solver`]); the sparse path overwrites `sys`'s
@@ -312,20 +318,21 @@ fn solve_dense(
             "every degree of freedom is fixed or constrained".into(),
         ));
     }
+    let kr = basis.transpose() * &lin.k * &basis;
+    let cr = basis.transpose() * &lin.c * &basis;
+    let mr = basis.transpose() * &lin.m * &basis;
+    // The mass before the count: a massless model has nothing to vibrate, whatever the count.
+    if max_abs(&mr) == 0.0 {
+        return Err(ModesError::NothingToVibrate(
+            "no mass on any free degree of freedom".into(),
+        ));
+    }
     if count > free {
         return Err(ModesError::TooMany {
             count,
             free,
             finite: free,
         });
-    }
-    let kr = basis.transpose() * &lin.k * &basis;
-    let cr = basis.transpose() * &lin.c * &basis;
-    let mr = basis.transpose() * &lin.m * &basis;
-    if max_abs(&mr) == 0.0 {
-        return Err(ModesError::NothingToVibrate(
-            "no mass on any free degree of freedom".into(),
-        ));
     }
     let kn = max_abs(&kr);
     let asymmetry = if kn > 0.0 {
@@ -357,10 +364,36 @@ fn solve_dense(
         });
     }
     let w2max = raw.iter().fold(0.0f64, |m, r| m.max(r.omega2.abs()));
-    let zero = dense::ZERO_FACTOR * f64::EPSILON * w2max;
+    // The zero threshold against the model's stiffness scale `‖K‖/‖M‖` (max-abs norms of
+    // the assembled, unreduced matrices, 1/s²), not against ω²_max alone: when every mode
+    // is a zero (a single pendulum at rest with its link horizontal), ω²_max is round-off
+    // itself and a relative threshold calls it a frequency. The entries of K carry
+    // ε‖K‖, so a computed ω² carries ε‖K‖/‖M‖ (ZERO_FACTOR of it: [`dense::ZERO_FACTOR`]);
+    // the shift of [`dense::conservative`] adds ε σ, σ = 1e-8 ω²_max (or 1e-8 1/s² on a
+    // model without stiffness): the floor `1e-8` below.
+    let stiffness_scale = model_scale(&lin.k, &lin.m).max(w2max).max(1e-8);
+    let zero = dense::ZERO_FACTOR * f64::EPSILON * stiffness_scale;
     let is_zero = |r: &dense::RawMode| r.omega2.abs() <= zero;
     let rigid_modes = raw.iter().filter(|r| is_zero(r)).count();
-    let highest_hz = w2max.sqrt() / (2.0 * PI);
+    let w2max_finite = raw
+        .iter()
+        .filter(|r| !is_zero(r))
+        .fold(0.0f64, |m, r| m.max(r.omega2.abs()));
+    let highest_hz = w2max_finite.sqrt() / (2.0 * PI);
+    // Round-off of Re s in the first-order form `A = [0 I; −M⁻¹K −M⁻¹C]`: the dense
+    // eigen-solver is backward stable, `δA ~ ε‖A‖`, `‖A‖ ≈ max(1, ‖K‖/‖M‖, ‖C‖/‖M‖, ω²_max)`
+    // (SI units of the assembly), and moves an eigenvalue by its condition number times
+    // that. For the undamped pair `s = ±iω` the right and left eigenvectors are `(φ, sφ)`
+    // and `(sφ, φ)`-like, condition `(1 + ω²)/(2ω)`; so `|δRe s| ≲ ε‖A‖(1 + |s|²)/(2|s|)`,
+    // ZERO_FACTOR of it as for ω². Below it the sign of Re s is round-off: the mode is
+    // neither damped nor unstable (the heavy top's ζ = −1.9e-15 at |s| = 4.75 1/s; the
+    // pendulum at 0.05 s: ζ = −2.6e-6 at |s| = 5.7 1/s with ω²_max = 9.4e10 1/s²).
+    let re_tol = if method == Method::StateSpace {
+        let a_norm = 1f64.max(stiffness_scale).max(model_scale(&lin.c, &lin.m));
+        dense::ZERO_FACTOR * f64::EPSILON * a_norm
+    } else {
+        0.0
+    };
     // Rigid first, unstable next, then by ω².
     let mut order: Vec<&dense::RawMode> = raw.iter().collect();
     order.sort_by_key(|r| u8::from(!is_zero(r)));
@@ -389,9 +422,17 @@ fn solve_dense(
         .map(|r| {
             let phi: DVector<f64> = &basis * &r.shape;
             let phi = phi.iter().copied().collect();
+            let (re, im) = r.s;
+            let w = re.hypot(im);
+            let tol = if w > 0.0 {
+                re_tol * (1.0 + w * w) / (2.0 * w)
+            } else {
+                0.0
+            };
+            let s = if re.abs() <= tol { (0.0, im) } else { r.s };
             make_mode_s(
                 phi,
-                clean(r.s),
+                clean(s),
                 is_zero(r),
                 &lin.locals,
                 &group_of,
@@ -468,7 +509,8 @@ fn make_mode_s(
         kind,
         frequency_hz: im / (2.0 * PI),
         natural_hz: w / (2.0 * PI),
-        damping_ratio: if w > 0.0 { -re / w } else { 0.0 },
+        // `+ 0.0` turns −0 (from `re = 0`) into +0.
+        damping_ratio: if w > 0.0 { -re / w + 0.0 } else { 0.0 },
         eigenvalue: (re, im),
         shape,
         kinetic_share: kin,

@@ -55,11 +55,11 @@ pub fn block(model: &Model, unknowns: usize) -> Option<serde_json::Value> {
         "highest_frequency_hz": a.highest_hz,
         "modes": step_resolution(&a, step),
         "integrators": integrators(&a, step),
-        "note": "one row per elastic mode, lowest first; last row: the mesh's highest frequency; period_error null = not resolved; integrators: the same rows for the deck's scheme and the others of its high_frequency_radius (issue 26)",
+        "note": "one row per elastic mode, lowest first; last row: the mesh's highest frequency; period_error null = not resolved; integrators: the same rows for the deck's scheme, then HHT, generalized-alpha and ESDIRK3 (hht::compared_schemes; issue 26)",
     }))
 }
 
-/// The rows of [`step_resolution`] for the deck's scheme and each other one at its `ρ∞`
+/// The rows of [`step_resolution`] for the deck's scheme and each other one
 /// ([`super::hht::compared_schemes`]): what each integrator does to each mode.
 fn integrators(a: &super::ModalAnalysis, step: super::output::DeckStep) -> serde_json::Value {
     super::hht::compared_schemes(&step.scheme)
