@@ -5,6 +5,7 @@
 //!   cargo bench --bench modes -- large        (the target; MODES_BENCH_BEAMS, default 8334)
 //!   cargo bench --bench modes -- crossover    (dense vs sparse, 10 modes, 150–600 unknowns)
 //!   MODES_BENCH_CPU=3 cargo bench --bench modes   (the target in CPU seconds, interleaved)
+//!   MODES_BENCH_LARGE_SH=1 ...                    (benches/large.sh's 83 m geometry instead)
 //!
 //! The model is a clamped steel cantilever of 10 m (square section 0.1 m) cut into n
 //! two-node beams (6 unknowns per free node: 6n; 8334 beams = 50,004, the size of
@@ -29,6 +30,24 @@ use std::time::Duration;
 /// modes, its bending planes apart by 1.5e-6 — not a model whose modes can be computed.
 /// Here ω₁² ≈ 28 1/s² against a threshold of ~1e-3.)
 fn deck(n: usize) -> String {
+    if std::env::var_os("MODES_BENCH_LARGE_SH").is_some() {
+        // benches/large.sh's geometry, for comparison (docs/modes.md).
+        return format!(
+            "TITLE cantilever of {n} beams
+MATERIALS
+  1 E 2.1e11 NU 0.3 RHO 7800
+SECTIONS
+  1 A 9e-4 I2 8.3e-8 I3 8.3e-8 J 4.15e-8 K 0.8333333333333334
+NODES
+  1 0 0 0 FIX ALL
+  2 {len:.2} 0 0
+ELEMENTS
+  1 BEAM 1 2 MAT 1 SEC 1 AXIS2 0 0 1 DIVIDE {n}
+ANALYSIS DYNAMIC STEP 1e-5 END 1e-4
+",
+            len = n as f64 * 0.01
+        );
+    }
     format!(
         "TITLE cantilever of {n} beams
 MATERIALS
