@@ -6,6 +6,7 @@
 //!   cargo bench --bench modes -- crossover    (dense vs sparse, 10 modes, 150–600 unknowns)
 //!   MODES_BENCH_CPU=3 cargo bench --bench modes   (the target in CPU seconds, interleaved)
 //!   MODES_BENCH_LARGE_SH=1 ...                    (benches/large.sh's 83 m geometry instead)
+//!   MODES_BENCH_DAMPING=1e-4 ...                  (material damping: the state-space path)
 //!
 //! The model is a clamped steel cantilever of 10 m (square section 0.1 m) cut into n
 //! two-node beams (6 unknowns per free node: 6n; 8334 beams = 50,004, the size of
@@ -30,6 +31,15 @@ use std::time::Duration;
 /// modes, its bending planes apart by 1.5e-6 — not a model whose modes can be computed.
 /// Here ω₁² ≈ 28 1/s² against a threshold of ~1e-3.)
 fn deck(n: usize) -> String {
+    let text = geometry(n);
+    // MODES_BENCH_DAMPING=η: the material a Kelvin–Voigt solid (the sparse state-space path).
+    match std::env::var("MODES_BENCH_DAMPING") {
+        Ok(eta) => text.replacen("RHO 7800", &format!("RHO 7800 DAMPING {eta}"), 1),
+        Err(_) => text,
+    }
+}
+
+fn geometry(n: usize) -> String {
     if std::env::var_os("MODES_BENCH_LARGE_SH").is_some() {
         // benches/large.sh's geometry, for comparison (docs/modes.md).
         return format!(
@@ -174,11 +184,16 @@ fn cpu_rounds(rounds: usize) {
         20,
     )
     .expect("sparse modes");
-    let hz: Vec<String> = found
+    let tau = 2.0 * std::f64::consts::PI;
+    let mut hz: Vec<String> = found
         .pairs
         .iter()
-        .map(|p| format!("{:.6e}", p.0.max(0.0).sqrt() / (2.0 * std::f64::consts::PI)))
+        .map(|p| format!("{:.6e}", p.0.max(0.0).sqrt() / tau))
         .collect();
+    hz.extend(found.damped.iter().map(|m| {
+        let w = m.s.0.hypot(m.s.1);
+        format!("{:.6e} (zeta {:.3e})", w / tau, -m.s.0 / w)
+    }));
     println!(
         "{} unknowns: {} solves, {} pivoting factorisations, block {}, shift {:.3e}, zero threshold {:.3e} 1/s², frequencies Hz {}",
         6 * n,
