@@ -58,8 +58,9 @@ pub struct ModesArgs {
     /// No table on standard output.
     #[arg(short, long)]
     pub quiet: bool,
-    /// Eigen-solver: `auto` (sparse shift-invert Lanczos from 300 unknowns for a
-    /// conservative model, dense otherwise), `dense` or `sparse`.
+    /// Eigen-solver: `auto` (sparse from 300 unknowns: shift-invert Lanczos for a
+    /// conservative model, Arnoldi on the first-order form for a damped or gyroscopic one;
+    /// dense otherwise), `dense` or `sparse`.
     #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
     pub solver: SolverArg,
 }
@@ -67,11 +68,12 @@ pub struct ModesArgs {
 /// `--solver`'s values.
 #[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SolverArg {
-    /// Sparse for large conservative models, dense otherwise.
+    /// Sparse for large models, dense otherwise.
     Auto,
     /// Dense (faer/nalgebra): every mode, the highest frequency.
     Dense,
-    /// Sparse shift-invert block Lanczos: the lowest modes of a conservative model.
+    /// Sparse shift-invert: block Lanczos (conservative) or block Arnoldi on the
+    /// first-order form (damped, gyroscopic): the lowest modes.
     Sparse,
 }
 

@@ -10,8 +10,9 @@
 //! `M = LLᵀ`), eigenvalues `s = −ζω ± iω√(1−ζ²)` (faer's dense
 //! eigen-decomposition), one mode per conjugate pair.
 //!
-//! Large models would call for shift-invert Lanczos on the project's sparse LU: not built
-//! yet (docs/modes.md).
+//! Large models: shift-invert Lanczos ([`super::sparse`]) and, damped or gyroscopic,
+//! shift-invert Arnoldi on the first-order form ([`super::sparse_damped`]) on the
+//! project's sparse LU, with this path's conventions (docs/modes.md).
 
 use faer::Mat;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};

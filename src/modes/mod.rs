@@ -19,6 +19,7 @@ pub mod output;
 pub mod rotating;
 pub mod run_summary;
 pub mod sparse;
+pub mod sparse_damped;
 pub mod vtk;
 
 use crate::elements::NodeState;
@@ -77,6 +78,9 @@ pub enum Method {
     StateSpace,
     /// Symmetric problem by sparse shift-invert block Lanczos ([`sparse`]).
     SparseSymmetric,
+    /// Quadratic problem by sparse shift-invert block Arnoldi on its first-order form
+    /// ([`sparse_damped`]).
+    SparseStateSpace,
 }
 
 /// The result of a modal analysis.
@@ -249,6 +253,36 @@ fn analyse_sparse(
     let found = sparse::lowest(sys, nodes, lambda, scale, t, count)?;
     let (group_names, group_of) = group_index(groups);
     let ng = group_names.len();
+    if !found.damped.is_empty() {
+        // The dense path's order: rigid first, then by |s| (already so ordered).
+        let is_zero = |s: (f64, f64)| s.0 * s.0 + s.1 * s.1 <= found.zero;
+        let mut raw: Vec<&sparse_damped::DampedMode> = found.damped.iter().collect();
+        raw.sort_by_key(|m| u8::from(!is_zero(m.s)));
+        let modes = raw
+            .into_iter()
+            .map(|m| {
+                make_mode_s(
+                    m.shape.clone(),
+                    m.s,
+                    is_zero(m.s),
+                    &found.locals,
+                    &group_of,
+                    ng,
+                )
+            })
+            .collect();
+        return Ok(ModalAnalysis {
+            modes,
+            free_unknowns: found.free_unknowns,
+            constraints: (found.constraints, found.constraints),
+            rigid_modes: found.damped.iter().filter(|m| is_zero(m.s)).count(),
+            finite_modes: found.free_unknowns,
+            highest_hz: f64::NAN,
+            method: Method::SparseStateSpace,
+            asymmetry: found.asymmetry,
+            groups: group_names,
+        });
+    }
     let is_zero = |w2: f64| w2.abs() <= found.zero;
     let mut pairs: Vec<&(f64, Vec<f64>)> = found.pairs.iter().collect();
     pairs.sort_by_key(|p| u8::from(!is_zero(p.0)));

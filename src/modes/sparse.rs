@@ -41,9 +41,13 @@
 //! `θ = 1/|σ|`. `ω² = 1/θ + σ` is exact to `ε|σ|` below `|σ|`; above it the Rayleigh
 //! quotient `φᵀKφ/φᵀMφ` is used (its error is quadratic in the shape's).
 //!
-//! Conservative and undamped only: the reduced `K` and `C` are checked on the final basis
-//! (`QᵀKQ` symmetric to [`super::ASYMMETRY_TOL`] of its largest entry, `QᵀCQ` below
-//! [`super::DAMPED_TOL`] of `√‖QᵀKQ‖`); otherwise [`SparseError::NotConservative`].
+//! Conservative and undamped only: a nodal `C` above [`super::DAMPED_TOL`] of
+//! `√(max|K| max|M|)` sends the model, before any solve, to the quadratic problem's
+//! solver ([`super::sparse_damped`]: shift-invert Arnoldi on the first-order form); the
+//! reduced `K` and `C` are checked on the final basis (`QᵀKQ` symmetric to
+//! [`super::ASYMMETRY_TOL`] of the model's stiffness scale, `QᵀCQ` below
+//! [`super::DAMPED_TOL`] of its square root), and a model that fails it is solved again
+//! by that solver.
 
 use super::linearise::{self, ElementMatrices};
 use crate::elements::NodeState;
@@ -64,16 +68,24 @@ pub const TOL: f64 = 1e-9;
 const DROP: f64 = 1e-10;
 /// Relative spread under which converged values are one cluster (a multiple eigenvalue).
 const CLUSTER: f64 = 1e-6;
+/// The smallest shift is `SHIFT_FLOOR · ε ω²_max`: the round-off of the assembled `K`
+/// (`ε ω²_max`, [`super::dense::ZERO_FACTOR`]) must not make `K − σM` singular.
+const SHIFT_FLOOR: f64 = 1e3;
 
 /// The modes the sparse solve found.
 pub struct SparseModes {
-    /// `(ω², shape)`, lowest first; the shape on the nodal equations, `φᵀMφ = 1`.
+    /// `(ω², shape)`, lowest first; the shape on the nodal equations, `φᵀMφ = 1`
+    /// (empty when the quadratic problem was solved: [`SparseModes::damped`]).
     pub pairs: Vec<(f64, Vec<f64>)>,
+    /// The modes of the quadratic problem, lowest `|λ|` first, when the model is damped,
+    /// gyroscopic or non-symmetric ([`super::sparse_damped`]); empty otherwise.
+    pub damped: Vec<super::sparse_damped::DampedMode>,
     /// Nodal unknowns less the constraint equations (full row rank: the LU is regular).
     pub free_unknowns: usize,
     /// Constraint equations.
     pub constraints: usize,
-    /// Relative asymmetry of `QᵀKQ` on the final basis.
+    /// Relative asymmetry of `QᵀKQ` on the final basis (of the nodal `K` for a model found
+    /// damped before the iteration).
     pub asymmetry: f64,
     /// Per element: its nodal `K` and `M`, for energy shares.
     pub locals: Vec<ElementMatrices>,
@@ -133,9 +145,9 @@ impl From<LinearError> for SparseError {
 struct Operator<'a> {
     sys: &'a mut System,
     nn: usize,
-    k: Vec<f64>,
-    m: Vec<f64>,
-    c: Vec<f64>,
+    k: &'a [f64],
+    m: &'a [f64],
+    c: &'a [f64],
     solves: usize,
 }
 
@@ -144,7 +156,7 @@ impl Operator<'_> {
     fn mul(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);
         let mat = &self.sys.matrix;
-        for (col, xc) in x.iter().enumerate() {
+        for (col, xc) in x.iter().enumerate().take(self.nn) {
             if *xc == 0.0 {
                 continue;
             }
@@ -159,14 +171,20 @@ impl Operator<'_> {
 
     fn mass(&self, x: &[f64]) -> Vec<f64> {
         let mut y = vec![0.0; self.nn];
-        self.mul(&self.m, x, &mut y);
+        self.mul(self.m, x, &mut y);
         y
     }
 
     /// `T v`: the nodal part of `A(σ)⁻¹ [M v; 0]`.
     fn apply(&mut self, v: &[f64]) -> Result<Vec<f64>, SparseError> {
+        let mv = self.mass(v);
+        self.apply_mass(&mv)
+    }
+
+    /// `T v` from `M v`.
+    fn apply_mass(&mut self, mv: &[f64]) -> Result<Vec<f64>, SparseError> {
         let mut rhs = vec![0.0; self.sys.n_eq()];
-        self.mul(&self.m, v, &mut rhs[..self.nn]);
+        rhs[..self.nn].copy_from_slice(mv);
         self.sys.matrix.solve(&mut rhs)?;
         self.solves += 1;
         rhs.truncate(self.nn);
@@ -174,8 +192,25 @@ impl Operator<'_> {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+/// `aᵀb` with eight partial sums (a sequential sum does not vectorise: the
+/// orthogonalisation, bound by these products, ran at a quarter of the speed).
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for ((s, x), y) in acc.iter_mut().zip(x).zip(y) {
+            *s += x * y;
+        }
+    }
+    acc.iter().sum::<f64>() + tail
 }
 
 fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
@@ -190,27 +225,30 @@ struct Basis {
 }
 
 impl Basis {
-    /// Projects `w` on the basis twice (Gram–Schmidt), returning the summed coefficients.
-    fn project(&self, w: &mut [f64]) -> Vec<f64> {
+    /// Projects `w` on the basis twice (Gram–Schmidt), returning the summed coefficients;
+    /// `mw`, when given, is `M w` and is kept so (`M q` is stored: no product).
+    fn project(&self, w: &mut [f64], mut mw: Option<&mut [f64]>) -> Vec<f64> {
         let mut coef = vec![0.0; self.q.len()];
         for _ in 0..2 {
             for (i, (q, mq)) in self.q.iter().zip(&self.mq).enumerate() {
                 let c = dot(mq, w);
                 axpy(w, -c, q);
+                if let Some(mw) = mw.as_deref_mut() {
+                    axpy(mw, -c, mq);
+                }
                 coef[i] += c;
             }
         }
         coef
     }
 
-    /// `M`-orthonormalises `ws` against the basis and each other, appending those that
-    /// are independent; returns how many were appended.
-    fn extend(&mut self, op: &Operator, ws: Vec<Vec<f64>>) -> usize {
+    /// `M`-orthonormalises `ws` (each with its mass image `M w`) against the basis and
+    /// each other, appending those that are independent; returns how many were appended.
+    fn extend(&mut self, ws: Vec<(Vec<f64>, Vec<f64>)>) -> usize {
         let mut added = 0;
-        for mut w in ws {
-            let n0 = dot(&op.mass(&w), &w).max(0.0).sqrt();
-            self.project(&mut w);
-            let mw = op.mass(&w);
+        for (mut w, mut mw) in ws {
+            let n0 = dot(&mw, &w).max(0.0).sqrt();
+            self.project(&mut w, Some(&mut mw));
             let n1 = dot(&mw, &w).max(0.0).sqrt();
             if n1 <= DROP * n0 || n1 == 0.0 {
                 continue;
@@ -304,22 +342,83 @@ pub fn lowest(
     if w2max == 0.0 {
         return Err(SparseError::Massless);
     }
-    let sigma = -1e-8 * w2max;
-    for (a, (kv, mv)) in sys.matrix.values.iter_mut().zip(k.iter().zip(&m)) {
-        *a = kv - sigma * mv;
+    let zero = super::dense::ZERO_FACTOR * f64::EPSILON * w2max;
+    // Damped or gyroscopic on the nodal equations (the dense path's test on NᵀCN, here
+    // before any solve): the quadratic problem's solver.
+    let nodal_max = |a: &[f64]| {
+        let mut mx = 0.0f64;
+        for col in 0..nn {
+            for p in sys.matrix.position_range(col) {
+                if sys.matrix.row_of(p) < nn {
+                    mx = mx.max(a[p].abs());
+                }
+            }
+        }
+        mx
+    };
+    let damped = nodal_max(&c) > super::DAMPED_TOL * (nodal_max(&k) * nodal_max(&m)).sqrt();
+    let state_space = |sys: &mut System, asymmetry: f64| -> Result<SparseModes, SparseError> {
+        let before = sys.matrix.pivoting_factorizations();
+        let found = super::sparse_damped::lowest(sys, &k, &c, &m, w2max, count)?;
+        Ok(SparseModes {
+            pairs: Vec::new(),
+            damped: found.modes,
+            free_unknowns: nn - constraints,
+            constraints,
+            asymmetry,
+            locals: Vec::new(),
+            solves: found.solves,
+            factorisations: (sys.matrix.pivoting_factorizations() - before) as usize,
+            block: super::sparse_damped::BLOCK,
+            shift: found.shift,
+            zero,
+        })
+    };
+    if damped {
+        // The nodal stiffness's relative asymmetry (the constrained one is not formed).
+        let mut asym = 0.0f64;
+        for col in 0..nn {
+            for p in sys.matrix.position_range(col) {
+                let r = sys.matrix.row_of(p);
+                if r < nn {
+                    let t = sys.matrix.position(col, r).map_or(0.0, |q| k[q]);
+                    asym = asym.max((k[p] - t).abs());
+                }
+            }
+        }
+        let kn = nodal_max(&k).max(f64::MIN_POSITIVE);
+        let mut out = state_space(sys, asym / kn)?;
+        out.locals = locals;
+        return Ok(out);
     }
-    sys.matrix.factor()?;
+    let mut sigma = -1e-8 * w2max;
+    let shift = |sys: &mut System, sigma: f64| -> Result<(), SparseError> {
+        for (a, (kv, mv)) in sys.matrix.values.iter_mut().zip(k.iter().zip(&m)) {
+            *a = kv - sigma * mv;
+        }
+        Ok(sys.matrix.factor()?)
+    };
+    shift(sys, sigma)?;
     let mut op = Operator {
         sys,
         nn,
-        k,
-        m,
-        c,
+        k: &k,
+        m: &m,
+        c: &c,
         solves: 0,
     };
     let mut block = BLOCK.min(count.max(1));
-    loop {
-        let (theta, basis) = iterate(&mut op, count, block)?;
+    let mut probe = Some((sigma, SHIFT_FLOOR * f64::EPSILON * w2max));
+    let result = loop {
+        let (theta, basis) = match iterate(&mut op, count, block, probe)? {
+            Outcome::Converged(theta, basis) => (theta, basis),
+            Outcome::Probe(target) => {
+                probe = None;
+                sigma = target;
+                shift(op.sys, sigma)?;
+                continue;
+            }
+        };
         // A cluster of converged values as large as the block may hide more copies.
         let big = theta.iter().any(|&x| {
             theta
@@ -332,33 +431,61 @@ pub fn lowest(
             block *= 2;
             continue;
         }
-        return finish(op, theta, basis, sigma, w2max, constraints, locals, block);
+        break finish(&op, theta, basis, sigma, w2max, constraints, block);
+    };
+    match result {
+        Ok(mut out) => {
+            out.locals = locals;
+            Ok(out)
+        }
+        // Non-symmetric on the constrained motions (follower loads, a rotating state):
+        // the quadratic problem's solver.
+        Err(SparseError::NotConservative { asymmetry, .. }) => {
+            let mut out = state_space(op.sys, asymmetry)?;
+            out.locals = locals;
+            Ok(out)
+        }
+        Err(e) => Err(e),
     }
 }
 
-/// Block Lanczos (module docs): the `count` Ritz values of largest `|θ|` and their
-/// vectors (`M`-orthonormal).
+/// What [`iterate`] ends with.
+enum Outcome {
+    /// The `count` Ritz values of largest `|θ|` and their vectors (`M`-orthonormal).
+    Converged(Vec<f64>, Vec<Vec<f64>>),
+    /// Asked to probe: the basis filled once without convergence, and the wanted modes
+    /// lie far below the shift; the better shift.
+    Probe(f64),
+}
+
+/// Block Lanczos (module docs) until the `count` Ritz values of largest `|θ|` converge,
+/// or, with `probe = Some((σ, floor))`, until the basis first fills if the wanted modes
+/// then lie far below the shift `σ` (more than 10 times closer to 0).
 fn iterate(
     op: &mut Operator,
     count: usize,
     block: usize,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), SparseError> {
+    probe: Option<(f64, f64)>,
+) -> Result<Outcome, SparseError> {
     let nn = op.nn;
     let free = nn - (op.sys.n_eq() - nn);
     let max_dim = (3 * count).max(count + 3 * block).max(30).min(free);
     let budget = op.solves + 40 * count + 400;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(24);
-    let mut random_block = |op: &mut Operator, b: usize| -> Result<Vec<Vec<f64>>, SparseError> {
+    type Pairs = Vec<(Vec<f64>, Vec<f64>)>;
+    let mut random_block = |op: &mut Operator, b: usize| -> Result<Pairs, SparseError> {
         (0..b)
             .map(|_| {
                 let r: Vec<f64> = (0..nn).map(|_| rng.random::<f64>() - 0.5).collect();
-                op.apply(&r)
+                let w = op.apply(&r)?;
+                let mw = op.mass(&w);
+                Ok((w, mw))
             })
             .collect()
     };
     let mut q = Basis::default();
     let start = random_block(op, block)?;
-    q.extend(op, start);
+    q.extend(start);
     if q.q.is_empty() {
         return Err(SparseError::Massless);
     }
@@ -372,8 +499,8 @@ fn iterate(
         let mut hn = DMatrix::<f64>::zeros(m_all, m_all);
         hn.view_mut((0, 0), (m_old, m_old)).copy_from(&h);
         for &j in &pending {
-            let mut w = op.apply(&q.q[j].clone())?;
-            let coef = q.project(&mut w);
+            let mut w = op.apply_mass(&q.mq[j].clone())?;
+            let coef = q.project(&mut w, None);
             for (i, cf) in coef.into_iter().enumerate() {
                 hn[(i, j)] = cf;
                 if i < m_old {
@@ -384,7 +511,8 @@ fn iterate(
         }
         let h_sym = (&hn + hn.transpose()) * 0.5;
         h = h_sym.clone();
-        // Gram matrix of the remainders, for the residuals.
+        // Gram matrix of the remainders, for the residuals (their mass images serve the
+        // next extension too).
         let mws: Vec<Vec<f64>> = ws.iter().map(|w| op.mass(w)).collect();
         let g = DMatrix::from_fn(ws.len(), ws.len(), |a, b| dot(&mws[a], &ws[b]));
         let eig = SymmetricEigen::new(h_sym);
@@ -417,7 +545,7 @@ fn iterate(
         };
         if converged == count {
             let theta = order[..count].iter().map(|&i| eig.eigenvalues[i]).collect();
-            return Ok((theta, ritz(&order[..count]).0));
+            return Ok(Outcome::Converged(theta, ritz(&order[..count]).0));
         }
         if op.solves >= budget || m_all >= free {
             return Err(SparseError::NoConvergence {
@@ -428,6 +556,17 @@ fn iterate(
         }
         // Restart on the best Ritz vectors when the next block would not fit.
         if m_all + pending.len() > max_dim {
+            if let Some((sigma, floor)) = probe {
+                // The count-th Ritz value bounds the count-th mode: θ_c(Ritz) ≤ θ_c, so
+                // ω²_c ≤ 1/θ_c(Ritz) + σ (Cauchy interlacing). When the wanted modes lie
+                // far below |σ|, their θ crowd at 1/|σ| and separate slowly: shift to
+                // half that bound, kept above the round-off of K (`floor`).
+                let bound = 1.0 / eig.eigenvalues[order[count - 1]] + sigma;
+                let target = -(0.5 * bound).max(floor);
+                if target > 0.1 * sigma {
+                    return Ok(Outcome::Probe(target));
+                }
+            }
             let keep: Vec<usize> = order[..(count + block).min(m_all)].to_vec();
             let (vq, vmq) = ritz(&keep);
             q = Basis { q: vq, mq: vmq };
@@ -439,11 +578,11 @@ fn iterate(
                 }
             });
         }
-        let added = q.extend(op, ws);
+        let added = q.extend(ws.into_iter().zip(mws).collect());
         if added == 0 {
             // An invariant subspace: continue from fresh random vectors.
             let fresh = random_block(op, block)?;
-            if q.extend(op, fresh) == 0 {
+            if q.extend(fresh) == 0 {
                 return Err(SparseError::NoConvergence {
                     converged,
                     count,
@@ -456,13 +595,12 @@ fn iterate(
 
 #[allow(clippy::too_many_arguments)]
 fn finish(
-    op: Operator,
+    op: &Operator,
     theta: Vec<f64>,
     basis: Vec<Vec<f64>>,
     sigma: f64,
     w2max: f64,
     constraints: usize,
-    locals: Vec<ElementMatrices>,
     block: usize,
 ) -> Result<SparseModes, SparseError> {
     let nn = op.nn;
@@ -471,10 +609,10 @@ fn finish(
     let mut cq = Vec::with_capacity(n);
     for phi in &basis {
         let mut y = vec![0.0; nn];
-        op.mul(&op.k, phi, &mut y);
+        op.mul(op.k, phi, &mut y);
         kq.push(y);
         let mut y = vec![0.0; nn];
-        op.mul(&op.c, phi, &mut y);
+        op.mul(op.c, phi, &mut y);
         cq.push(y);
     }
     let kr = DMatrix::from_fn(n, n, |i, j| dot(&basis[i], &kq[j]));
@@ -506,10 +644,11 @@ fn finish(
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(SparseModes {
         pairs,
+        damped: Vec::new(),
         free_unknowns: nn - constraints,
         constraints,
         asymmetry,
-        locals,
+        locals: Vec::new(),
         solves: op.solves,
         factorisations: op.sys.matrix.pivoting_factorizations() as usize,
         block,
