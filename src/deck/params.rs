@@ -126,7 +126,10 @@ pub(crate) fn resolve(
         let Some(value_tok) = card.tokens.get(1) else {
             errors.push(DeckError::new(
                 K::MissingField {
-                    expected: format!("the value of parameter `{name}` in PARAMETERS card"),
+                    expected: format!(
+                        "the value of parameter `{}` in PARAMETERS card",
+                        crate::deck::short(name)
+                    ),
                 },
                 Span::new(name_tok.span.end, name_tok.span.end),
             ));
