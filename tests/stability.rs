@@ -638,17 +638,8 @@ fn hht_spectral_radius_and_period_error_match_the_closed_form() {
             assert!(r.failure.is_none());
             let x: Vec<f64> = rec.nodes.iter().map(|n| n[1].x.x - 1.0).collect();
             let v: Vec<f64> = rec.nodes.iter().map(|n| n[1].v.x).collect();
-            // Upward zero crossings (x from < 0 to ≥ 0), interpolated.
-            let ups: Vec<(usize, f64)> = (1..x.len())
-                .filter(|&i| x[i - 1] < 0.0 && x[i] >= 0.0)
-                .map(|i| (i, rec.t[i - 1] + h * x[i - 1] / (x[i - 1] - x[i])))
-                .collect();
-            let (i0, t0) = ups[0];
-            let (i1, t1) = *ups.last().unwrap();
-            let period = (t1 - t0) / (ups.len() - 1) as f64;
-            let period_err_meas = period / (2.0 * PI / w) - 1.0;
-            let en = |i: usize| 0.5 * (v[i] * v[i] + w * w * x[i] * x[i]);
-            let rho_meas = (en(i1) / en(i0)).powf(1.0 / (2.0 * (i1 - i0) as f64));
+            let (rho_meas, period_err_meas) =
+                common::oscillator::radius_and_period_error(&rec.t, &x, &v, h, w);
             println!(
                 "alpha = {alpha:.4}, Omega = {big_omega}: rho {rho_meas:.5} (closed form {rho:.5}), period error {period_err_meas:.5} (closed form {period_err:.5})"
             );

@@ -14,6 +14,7 @@
 pub mod about;
 pub mod dense;
 pub mod hht;
+pub mod krylov;
 pub mod linearise;
 pub mod output;
 pub mod rotating;

@@ -49,6 +49,7 @@
 //! [`super::DAMPED_TOL`] of its square root), and a model that fails it is solved again
 //! by that solver.
 
+use super::krylov::{Basis, dot};
 use super::linearise::{self, ElementMatrices};
 use crate::elements::NodeState;
 use crate::solver::linear::LinearError;
@@ -63,9 +64,6 @@ pub const BLOCK: usize = 6;
 /// itself inside a cluster: 1e-9 keeps frequencies to ~1e-9 even for exact pairs, and the
 /// Rayleigh quotient of the shape makes it smaller still.
 pub const TOL: f64 = 1e-9;
-/// A vector whose `M`-norm falls below this fraction of its norm before projection is
-/// linearly dependent on the basis (after two Gram–Schmidt passes, round-off leaves ~ε).
-const DROP: f64 = 1e-10;
 /// Relative spread under which converged values are one cluster (a multiple eigenvalue).
 const CLUSTER: f64 = 1e-6;
 /// The smallest shift is `SHIFT_FLOOR · ε ω²_max`: the round-off of the assembled `K`
@@ -189,87 +187,6 @@ impl Operator<'_> {
         self.solves += 1;
         rhs.truncate(self.nn);
         Ok(rhs)
-    }
-}
-
-/// `aᵀb` with eight partial sums (a sequential sum does not vectorise: the
-/// orthogonalisation, bound by these products, ran at a quarter of the speed).
-pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for ((s, x), y) in acc.iter_mut().zip(x).zip(y) {
-            *s += x * y;
-        }
-    }
-    acc.iter().sum::<f64>() + tail
-}
-
-fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
-    y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
-}
-
-/// An `M`-orthonormal basis with the mass images of its vectors.
-#[derive(Default)]
-struct Basis {
-    q: Vec<Vec<f64>>,
-    mq: Vec<Vec<f64>>,
-}
-
-impl Basis {
-    /// Projects `w` on the basis twice (Gram–Schmidt), returning the summed coefficients;
-    /// `mw`, when given, is `M w` and is kept so (`M q` is stored: no product).
-    fn project(&self, w: &mut [f64], mut mw: Option<&mut [f64]>) -> Vec<f64> {
-        let mut coef = vec![0.0; self.q.len()];
-        for _ in 0..2 {
-            for (i, (q, mq)) in self.q.iter().zip(&self.mq).enumerate() {
-                let c = dot(mq, w);
-                axpy(w, -c, q);
-                if let Some(mw) = mw.as_deref_mut() {
-                    axpy(mw, -c, mq);
-                }
-                coef[i] += c;
-            }
-        }
-        coef
-    }
-
-    /// `M`-orthonormalises `ws` (each with its mass image `M w`) against the basis and
-    /// each other, appending those that are independent; returns how many were appended.
-    fn extend(&mut self, ws: Vec<(Vec<f64>, Vec<f64>)>) -> usize {
-        let mut added = 0;
-        for (mut w, mut mw) in ws {
-            let n0 = dot(&mw, &w).max(0.0).sqrt();
-            self.project(&mut w, Some(&mut mw));
-            let n1 = dot(&mw, &w).max(0.0).sqrt();
-            if n1 <= DROP * n0 || n1 == 0.0 {
-                continue;
-            }
-            w.iter_mut().for_each(|v| *v /= n1);
-            self.mq.push(mw.into_iter().map(|v| v / n1).collect());
-            self.q.push(w);
-            added += 1;
-        }
-        added
-    }
-
-    /// `Σ_j s_j q_j` over the basis.
-    fn combine(vs: &[Vec<f64>], s: impl Iterator<Item = f64>, n: usize) -> Vec<f64> {
-        let mut y = vec![0.0; n];
-        for (v, sj) in vs.iter().zip(s) {
-            if sj != 0.0 {
-                axpy(&mut y, sj, v);
-            }
-        }
-        y
     }
 }
 

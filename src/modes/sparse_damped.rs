@@ -44,12 +44,14 @@
 //! included), as a backward error `‖r‖/((|λ|²‖M‖ + |λ|‖C‖ + ‖K‖)‖x‖)` (∞-norms) below
 //! [`TOL_QUADRATIC`].
 
-use super::sparse::{SparseError, dot};
-use crate::solver::linear::SparseSystem;
+mod ritz;
+
+use super::krylov::{DROP, axpy, dot, norm, pattern_mul};
+use super::sparse::SparseError;
 use crate::solver::system::System;
-use faer::Mat;
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
+use ritz::{Ritz, cdiv, ritz_pairs};
 
 /// Block size (as the symmetric path's: six rigid motions of a free body).
 pub const BLOCK: usize = 6;
@@ -62,9 +64,6 @@ const TOL_KRYLOV: f64 = 1e-9;
 /// passes (a 366-unknown spinning shaft, |λ| up to 1e4 1/s), so 1e-8 checks the original
 /// problem without asking what the first-order form's scaling cannot give.
 pub const TOL_QUADRATIC: f64 = 1e-8;
-/// A vector whose norm falls below this fraction of its norm before projection is
-/// linearly dependent on the basis.
-const DROP: f64 = 1e-10;
 
 /// A mode of the quadratic problem.
 #[derive(Debug, Clone)]
@@ -88,42 +87,6 @@ pub struct DampedModes {
     pub solves: usize,
     /// The shift `σ`, 1/s.
     pub shift: f64,
-}
-
-/// `y = A x` over the pattern of `mat` with values `a`, rows and columns below `rows`,
-/// `cols` (`y` has `rows` entries).
-pub(super) fn pattern_mul(
-    mat: &SparseSystem,
-    a: &[f64],
-    x: &[f64],
-    y: &mut [f64],
-    rows: usize,
-    abs: bool,
-) {
-    y.iter_mut().for_each(|v| *v = 0.0);
-    for (col, xc) in x.iter().enumerate() {
-        if *xc == 0.0 {
-            continue;
-        }
-        for p in mat.position_range(col) {
-            let r = mat.row_of(p);
-            if r < rows {
-                y[r] += if abs {
-                    a[p].abs() * xc.abs()
-                } else {
-                    a[p] * xc
-                };
-            }
-        }
-    }
-}
-
-fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
-    y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
-}
-
-fn norm(a: &[f64]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// `T` of the module docs with its LU, and the nodal `K` (with its multiplier rows and
@@ -262,43 +225,6 @@ impl Space {
                 .collect(),
         }
     }
-}
-
-/// A Ritz pair of `H`: `μ` and the real and imaginary parts of its vector.
-struct Ritz {
-    mu: (f64, f64),
-    s: (Vec<f64>, Vec<f64>),
-}
-
-fn cdiv(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
-    let d = b.0 * b.0 + b.1 * b.1;
-    ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
-}
-
-fn ritz_pairs(h: &DMatrix<f64>) -> Result<Vec<Ritz>, SparseError> {
-    let m = h.nrows();
-    let a = Mat::<f64>::from_fn(m, m, |i, j| h[(i, j)]);
-    let evd = a.eigen().map_err(|_| SparseError::NoConvergence {
-        converged: 0,
-        count: 0,
-        solves: 0,
-    })?;
-    let s: Vec<_> = evd.S().column_vector().iter().copied().collect();
-    let u = evd.U();
-    Ok((0..m)
-        .map(|k| {
-            let re = (0..m).map(|i| u[(i, k)].re).collect::<Vec<_>>();
-            let im = (0..m).map(|i| u[(i, k)].im).collect::<Vec<_>>();
-            let nrm = (dot(&re, &re) + dot(&im, &im)).sqrt();
-            Ritz {
-                mu: (s[k].re, s[k].im),
-                s: (
-                    re.iter().map(|x| x / nrm).collect(),
-                    im.iter().map(|x| x / nrm).collect(),
-                ),
-            }
-        })
-        .collect())
 }
 
 /// The lowest `count` modes by `|λ|` of the quadratic problem at the assembled `k`

@@ -7,6 +7,7 @@
 #![allow(dead_code)]
 
 pub mod impact;
+pub mod oscillator;
 
 use mecano::deck::load_deck;
 use mecano::model::Model;
