@@ -49,10 +49,10 @@
 //! [`super::DAMPED_TOL`] of its square root), and a model that fails it is solved again
 //! by that solver.
 
+pub use super::krylov::SparseError;
 use super::krylov::{Basis, dot};
 use super::linearise::{self, ElementMatrices};
 use crate::elements::NodeState;
-use crate::solver::linear::LinearError;
 use crate::solver::system::System;
 use nalgebra::{DMatrix, SymmetricEigen};
 use rand::{Rng, SeedableRng};
@@ -98,45 +98,6 @@ pub struct SparseModes {
     /// `ε`-scale threshold below which `|ω²|` is a rigid motion (the dense path's rule with
     /// the diagonal estimate of `ω²_max`).
     pub zero: f64,
-}
-
-/// Why the sparse solve did not give modes.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SparseError {
-    /// The model at this state is damped, gyroscopic or non-symmetric.
-    #[error(
-        "the sparse solver handles conservative undamped models: at this state the reduced stiffness is asymmetric to {asymmetry:.1e} and the damping/gyroscopic matrix is {damping:.1e} of it"
-    )]
-    NotConservative {
-        /// Relative asymmetry of `QᵀKQ`.
-        asymmetry: f64,
-        /// `max|QᵀCQ| / √max|QᵀKQ|`.
-        damping: f64,
-    },
-    /// `A(σ)` is singular (redundant constraints, or a free direction with no mass).
-    #[error(
-        "the shifted saddle-point matrix [K - sM, B'; B, 0] is singular ({0}): redundant constraints?"
-    )]
-    Singular(String),
-    /// No mass on the free unknowns.
-    #[error("no mass on any free degree of freedom")]
-    Massless,
-    /// The iteration did not converge within its budget of solves.
-    #[error("shift-invert Lanczos: {converged} of {count} modes converged after {solves} solves")]
-    NoConvergence {
-        /// Converged modes.
-        converged: usize,
-        /// Asked for.
-        count: usize,
-        /// Solves spent.
-        solves: usize,
-    },
-}
-
-impl From<LinearError> for SparseError {
-    fn from(e: LinearError) -> Self {
-        SparseError::Singular(e.to_string())
-    }
 }
 
 /// The nodal `K`, `M`, `C` on the pattern of the system's iteration matrix.

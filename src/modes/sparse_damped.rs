@@ -46,8 +46,7 @@
 
 mod ritz;
 
-use super::krylov::{DROP, axpy, dot, norm, pattern_mul};
-use super::sparse::SparseError;
+use super::krylov::{DROP, SparseError, axpy, dot, norm, pattern_mul};
 use crate::solver::system::System;
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};

@@ -2,8 +2,8 @@
 //! non-symmetric matrix): its eigenvalues `μ` and the real and imaginary parts of their
 //! vectors, by faer's dense eigen-decomposition.
 
+use super::super::krylov::SparseError;
 use super::super::krylov::dot;
-use super::super::sparse::SparseError;
 use faer::Mat;
 use nalgebra::DMatrix;
 
