@@ -490,6 +490,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "third-order L-stable ESDIRK time integrator instead of HHT",
     ),
     kw(
+        "ESDIRK5",
+        "ANALYSIS",
+        "fifth-order L-stable ESDIRK time integrator instead of HHT",
+    ),
+    kw(
         "MINSTEP",
         "ANALYSIS",
         "smallest step when cutting, s (default STEP/1024)",

@@ -400,7 +400,11 @@ pub fn write_deck(model: &Model) -> String {
                 Scheme::GeneralizedAlpha { rho_inf } => {
                     write!(s, "ANALYSIS DYNAMIC GENALPHA RHOINF {rho_inf:?}")
                 }
-                Scheme::Esdirk3 => write!(s, "ANALYSIS DYNAMIC ESDIRK3"),
+                Scheme::Esdirk3 | Scheme::Esdirk5 => write!(
+                    s,
+                    "ANALYSIS DYNAMIC {}",
+                    scheme.esdirk_keyword().unwrap_or_default()
+                ),
             };
             let _ = write!(
                 s,

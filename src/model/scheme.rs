@@ -31,6 +31,9 @@ pub enum Scheme {
     /// (`solver::integrator::esdirk`): third order, L-stable (`ρ∞ = 0`), three implicit
     /// stages per step. Deck: `ESDIRK3`.
     Esdirk3,
+    /// Kennedy & Carpenter's (2016) ESDIRK5(4)7L[2]SA2 on the Lie group: fifth order (third
+    /// with index-3 constraints), L-stable, six implicit stages per step. Deck: `ESDIRK5`.
+    Esdirk5,
 }
 
 impl Default for Scheme {
@@ -44,7 +47,9 @@ impl Default for Scheme {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SchemeNameError {
     /// Not one of [`Scheme::NAMES`].
-    #[error("unknown integrator '{0}' (expected hht[:alpha], genalpha[:rho_inf] or esdirk3)")]
+    #[error(
+        "unknown integrator '{0}' (expected hht[:alpha], genalpha[:rho_inf], esdirk3 or esdirk5)"
+    )]
     Unknown(String),
     /// The parameter after `:` is not a number in the scheme's range.
     #[error("integrator '{name}': the parameter '{value}' is not a number in {range}")]
@@ -65,7 +70,7 @@ impl Scheme {
     pub const DEFAULT_RHO_INF: f64 = 0.8;
 
     /// The names [`Scheme::parse`] accepts (`study --integrator`).
-    pub const NAMES: &'static [&'static str] = &["hht", "genalpha", "esdirk3"];
+    pub const NAMES: &'static [&'static str] = &["hht", "genalpha", "esdirk3", "esdirk5"];
 
     /// Short name: `hht`, `genalpha` (command line, file columns).
     pub fn name(&self) -> &'static str {
@@ -73,6 +78,7 @@ impl Scheme {
             Scheme::Hht { .. } => "hht",
             Scheme::GeneralizedAlpha { .. } => "genalpha",
             Scheme::Esdirk3 => "esdirk3",
+            Scheme::Esdirk5 => "esdirk5",
         }
     }
 
@@ -82,7 +88,21 @@ impl Scheme {
         match *self {
             Scheme::Hht { alpha } => format!("hht:{alpha}"),
             Scheme::GeneralizedAlpha { rho_inf } => format!("genalpha:{rho_inf}"),
-            Scheme::Esdirk3 => "esdirk3".to_string(),
+            Scheme::Esdirk3 | Scheme::Esdirk5 => self.name().to_string(),
+        }
+    }
+
+    /// Whether the scheme is one of the ESDIRK family (stages, R(∞) = 0).
+    pub fn is_esdirk(&self) -> bool {
+        matches!(self, Scheme::Esdirk3 | Scheme::Esdirk5)
+    }
+
+    /// The ESDIRK scheme's deck keyword (`ESDIRK3`…), `None` for the α family.
+    pub fn esdirk_keyword(&self) -> Option<&'static str> {
+        match self {
+            Scheme::Esdirk3 => Some("ESDIRK3"),
+            Scheme::Esdirk5 => Some("ESDIRK5"),
+            _ => None,
         }
     }
 
@@ -99,7 +119,7 @@ impl Scheme {
         match *self {
             Scheme::Hht { alpha } => (1.0 + alpha) / (1.0 - alpha),
             Scheme::GeneralizedAlpha { rho_inf } => rho_inf,
-            Scheme::Esdirk3 => 0.0,
+            Scheme::Esdirk3 | Scheme::Esdirk5 => 0.0,
         }
     }
 
@@ -135,6 +155,7 @@ impl Scheme {
                 },
             }),
             "esdirk3" if value.is_none() => Ok(Scheme::Esdirk3),
+            "esdirk5" if value.is_none() => Ok(Scheme::Esdirk5),
             _ => Err(SchemeNameError::Unknown(s.to_string())),
         }
     }
@@ -160,6 +181,7 @@ impl fmt::Display for Scheme {
                 write!(f, "generalized-alpha rho_inf {rho_inf}")
             }
             Scheme::Esdirk3 => write!(f, "ESDIRK3"),
+            Scheme::Esdirk5 => write!(f, "ESDIRK5"),
         }
     }
 }

@@ -64,11 +64,12 @@ pub fn spectral(scheme: &Scheme, omega_h: f64) -> Spectral {
         Scheme::Hht { .. } | Scheme::GeneralizedAlpha { .. } => {
             principal_of(&amplification(&AlphaParams::of(scheme), omega_h), omega_h)
         }
-        Scheme::Esdirk3 => {
+        Scheme::Esdirk3 | Scheme::Esdirk5 => {
             // A Runge–Kutta scheme's amplification of the mode is R(iΩ) (module docs of
             // `solver::integrator::esdirk`), its conjugate pair the mode's other root.
-            let z =
-                crate::solver::integrator::esdirk::stability(nalgebra::Complex::new(0.0, omega_h));
+            let tab = crate::solver::integrator::esdirk::tableau_of(scheme)
+                .expect("an ESDIRK scheme has a tableau");
+            let z = tab.stability(nalgebra::Complex::new(0.0, omega_h));
             let arg = z.im.atan2(z.re);
             Spectral {
                 omega_h,
@@ -187,7 +188,7 @@ pub fn compared_schemes(deck: &Scheme) -> Vec<Scheme> {
         Scheme::Hht { .. } => Scheme::GeneralizedAlpha {
             rho_inf: deck.rho_inf(),
         },
-        Scheme::Esdirk3 => Scheme::GeneralizedAlpha {
+        Scheme::Esdirk3 | Scheme::Esdirk5 => Scheme::GeneralizedAlpha {
             rho_inf: hht.rho_inf(),
         },
     };

@@ -41,6 +41,9 @@ pub const CONSTRAINT_TOL: f64 = 1e-11;
 /// residual by at least 1/CONTRACTION.
 pub const CONTRACTION: f64 = 0.25;
 
+/// [`CONTRACTION`] for the stages of the ESDIRK schemes (`newton.rs`).
+pub const STAGE_CONTRACTION: f64 = 0.5;
+
 /// `max` that propagates NaN (`f64::max` drops it: a NaN residual would pass for zero).
 #[inline]
 fn nan_max(a: f64, b: f64) -> f64 {
@@ -103,7 +106,7 @@ impl AlphaParams {
             Scheme::GeneralizedAlpha { rho_inf } => AlphaParams::generalized(rho_inf),
             // Not an α scheme: the trapezoidal rule's coefficients stand for the queries that
             // assume one (a bench's `step_context`, the adaptive steps' error measure).
-            Scheme::Esdirk3 => AlphaParams::new(0.0),
+            Scheme::Esdirk3 | Scheme::Esdirk5 => AlphaParams::new(0.0),
         }
     }
 
@@ -237,8 +240,9 @@ impl Integrator {
         let nodes: Vec<NodeState> = sys.x0.iter().map(|x| NodeState::at_rest(*x)).collect();
         let n = sys.n_eq();
         let nn = nodes.len();
-        let esdirk =
-            (dynamic && scheme == Scheme::Esdirk3).then(|| Box::new(esdirk::Stages::sized(nn)));
+        let esdirk = esdirk::tableau_of(&scheme)
+            .filter(|_| dynamic)
+            .map(|tab| Box::new(esdirk::Stages::sized(&sys, tab)));
         Integrator {
             lu_step: f64::NAN,
             trial: nodes.clone(),
@@ -359,11 +363,26 @@ impl Integrator {
 /// along `v` (the restart's `Ḃv`, the ESDIRK stages' `B v`).
 fn moved_along_velocities(nodes: &[NodeState], dt: f64, out: &mut Vec<NodeState>) {
     out.clear();
-    out.extend(nodes.iter().map(|s| NodeState {
-        x: s.x + s.v * dt,
-        r: s.r * rotation::exp(&(s.w * dt)),
-        ..*s
-    }));
+    out.extend_from_slice(nodes);
+    moved_some_along_velocities(nodes, dt, 0..nodes.len(), out);
+}
+
+/// [`moved_along_velocities`] for the nodes `which` alone, into `out` (already sized; the
+/// other nodes of `out` are left as they are).
+fn moved_some_along_velocities(
+    nodes: &[NodeState],
+    dt: f64,
+    which: impl IntoIterator<Item = usize>,
+    out: &mut [NodeState],
+) {
+    for k in which {
+        let s = &nodes[k];
+        out[k] = NodeState {
+            x: s.x + s.v * dt,
+            r: s.r * rotation::exp(&(s.w * dt)),
+            ..*s
+        };
+    }
 }
 
 mod error;

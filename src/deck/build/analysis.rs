@@ -133,8 +133,9 @@ impl Builder<'_> {
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
-                "ALPHA", "GENALPHA", "RHOINF", "ESDIRK3", "STEP", "END", "MINSTEP", "MAXSTEP",
-                "ADAPTIVE", "TOLPOS", "TOLROT", "GROWTH", "TOL", "TOLINC", "MAXIT", "NEWTON",
+                "ALPHA", "GENALPHA", "RHOINF", "ESDIRK3", "ESDIRK5", "STEP", "END", "MINSTEP",
+                "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT", "GROWTH", "TOL", "TOLINC", "MAXIT",
+                "NEWTON",
             ]
         } else {
             &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
@@ -171,7 +172,17 @@ impl Builder<'_> {
                 "MINSTEP" => min = Some(c.number("MINSTEP (smallest step)")?),
                 "MAXSTEP" => max = Some(c.number("MAXSTEP (largest step)")?),
                 "ADAPTIVE" => adaptive = Some(ks),
-                "ESDIRK3" => esdirk = Some(ks),
+                "ESDIRK3" | "ESDIRK5" => {
+                    let scheme = if kw == "ESDIRK3" {
+                        Scheme::Esdirk3
+                    } else {
+                        Scheme::Esdirk5
+                    };
+                    if let Some((_, other, _)) = esdirk {
+                        return Err(conflict(other, kw, &c.ctx, ks));
+                    }
+                    esdirk = Some((scheme, kw, ks));
+                }
                 "TOLPOS" => tolpos = Some(c.number_in("TOLPOS", "> 0 m", pos)?),
                 "TOLROT" => tolrot = Some(c.number_in("TOLROT", "> 0 rad", pos)?),
                 "GROWTH" => growth = c.number_in("GROWTH", ">= 1", |v| v >= 1.0)?,
@@ -251,21 +262,21 @@ impl Builder<'_> {
                     None
                 }
             };
-            let scheme = match genalpha {
-                _ if esdirk.is_some() && seen.has("ALPHA") => {
-                    return Err(conflict("ALPHA", "ESDIRK3", &c.ctx, esdirk.unwrap()));
+            let scheme = match (genalpha, esdirk) {
+                (_, Some((_, kw, ks))) if seen.has("ALPHA") => {
+                    return Err(conflict("ALPHA", kw, &c.ctx, ks));
                 }
-                Some(gs) if esdirk.is_some() => {
-                    return Err(conflict("GENALPHA", "ESDIRK3", &c.ctx, gs));
+                (Some(gs), Some((_, kw, _))) => {
+                    return Err(conflict("GENALPHA", kw, &c.ctx, gs));
                 }
-                None if esdirk.is_some() && !seen.has("RHOINF") => Scheme::Esdirk3,
-                Some(gs) if seen.has("ALPHA") => {
+                (None, Some((scheme, _, _))) if !seen.has("RHOINF") => scheme,
+                (Some(gs), None) if seen.has("ALPHA") => {
                     return Err(conflict("ALPHA", "GENALPHA", &c.ctx, gs));
                 }
-                Some(_) => Scheme::GeneralizedAlpha {
+                (Some(_), None) => Scheme::GeneralizedAlpha {
                     rho_inf: rho_inf.unwrap_or(Scheme::DEFAULT_RHO_INF),
                 },
-                None if seen.has("RHOINF") => {
+                (None, _) if seen.has("RHOINF") => {
                     return Err(DeckError::new(
                         K::MissingKeyword {
                             context: format!("RHOINF in {}", c.ctx),
@@ -274,7 +285,7 @@ impl Builder<'_> {
                         c.end_span(),
                     ));
                 }
-                None => Scheme::Hht { alpha },
+                (None, _) => Scheme::Hht { alpha },
             };
             Analysis::Dynamic {
                 scheme,

@@ -1,78 +1,68 @@
-//! A third-order, L-stable, stiffly accurate ESDIRK scheme on the Lie group
-//! `(ℝ³ × SO(3))ⁿ`, with the index-3 constraints met at every stage.
+//! L-stable, stiffly accurate ESDIRK schemes on the Lie group `(ℝ³ × SO(3))ⁿ`, with the
+//! index-3 constraints met at every step's end: ESDIRK3 and ESDIRK5.
 //!
-//! # The scheme
-//! Kennedy & Carpenter's ESDIRK3(2)4L[2]SA (NASA/TM-2016-219173, § 5.2.1: four stages, the
-//! first explicit, the three others with the same diagonal `γ = 0.4358665215084590`, stage
-//! order 2, L-stable, `b = A`'s last row) applied to the first-order form of the equations
-//! of motion in the local coordinates of the group about the step's start (Munthe-Kaas'
-//! RKMK: Munthe-Kaas 1998, BIT 38; Iserles et al. 2000, Acta Numerica 9, § 5):
+//! # The schemes
+//! Kennedy & Carpenter's (NASA/TM-2016-219173) ESDIRK3(2)4L[2]SA (§ 5.2.1: four stages,
+//! `γ = 0.4358665215084590`) and ESDIRK5(4)7L[2]SA2 (§ 7.2.2: seven stages, `γ = 23/125`),
+//! their tableaux in [`tableau`]: the first stage explicit, the others with the same
+//! diagonal `γ`, stage order 2, L-stable, `b = A`'s last row. They are applied to the
+//! first-order form of the equations of motion in the local coordinates of the group about
+//! the step's start (Munthe-Kaas' RKMK: Munthe-Kaas 1998, BIT 38; Iserles et al. 2000, Acta
+//! Numerica 9, § 5):
 //! - per node, `x_i = x_n + U_i`, `R_i = R_n exp(Ũ_i)`, `U_i = h Σ_j a_ij Û_j`, where the
 //!   stage's algebra velocity is `Û_j = v_j` (translation) and `Û_j = T(U_j)⁻¹ Ω_j`
 //!   (rotation: `Ω = T(U) U̇`, paper eq. [3], so the RK stages see the exact `dexp⁻¹`);
 //! - `v_i = v_n + h Σ_j a_ij v̇_j`, `Ω_i = Ω_n + h Σ_j a_ij Ω̇_j` (material frame);
-//! - at each implicit stage, equilibrium `r(q_i, v_i, v̇_i, λ_i) = 0` and `Φ(q_i) = 0` at
-//!   `t_n + c_i h`, so the constraints hold at every stage and (stiffly accurate) at the
-//!   step's end, which is the last stage.
+//! - at each implicit stage, equilibrium `r(q_i, v_i, v̇_i, λ_i) = 0` at `t_n + c_i h`; the
+//!   inner stages meet the constraints at the velocity level, `B(q_i) v_i + ∂Φ/∂t = 0` (an
+//!   index-2 stage: Hairer & Wanner II, § VII.4, order min(p, q + 1) = 3 for stage order
+//!   q = 2), the last one at the position level, `Φ(q_{n+1}) = 0`, so the constraints hold
+//!   at every step's end (stiffly accurate: the last stage is the step's end).
+//!
+//! So both schemes are third order in the positions of a constrained model (the index-3
+//! order reduction of stage order 2); ESDIRK5 is fifth order without constraints (the free
+//! rigid body, tests/esdirk.rs) and has the smaller error constants: it keeps the modes
+//! up to `ωh ≈ 5` (`1 − |R(iωh)|` = 3.8e-5 at `ωh = 1`, 8.6e-3 at 5) where ESDIRK3 damps
+//! them (1.8e-2 at 1, 0.48 at 5).
 //!
 //! Stage 1 is the start state itself: its accelerations are the consistent ones the last
 //! stage of the previous step (or [`Integrator::consistent_accelerations`] at a start or
 //! a contact's restart) solved, so the scheme is one-step in `(q, v)` and keeps no history
-//! across steps (a checkpoint needs nothing more than HHT's).
+//! across steps (a checkpoint needs nothing more than HHT's). Each stage's Newton starts
+//! from [`predict`]'s extrapolation of the stages already solved in the same step.
 //!
 //! Newton's unknown at stage i is `U_i`; then `∂v_i/∂U_i = 1/(γh)` and
 //! `∂v̇_i/∂U_i = 1/(γh)²` exactly for translations (and to `O(|U|)` for rotations, where
 //! `T(U)` is left out of the inertia's columns): the iteration matrix is HHT's with
-//! `c_v = 1/(γh)`, `c_a = 1/(γh)²`, the same for the three stages and for every step of
+//! `c_v = 1/(γh)`, `c_a = 1/(γh)²`, the same for all the stages and for every step of
 //! the same size, so modified Newton keeps one factorisation across stages and steps.
 //! Linear stability (all stages share `γ`): `R(z) = 1 + z bᵀ(I − zA)⁻¹1`, `|R(iωh)| < 1`
 //! for `ωh > 0`, `R(∞) = 0` (L-stable): high frequencies are annihilated, the low ones
-//! damped by `O((ωh)⁴)` per step.
+//! damped by `O((ωh)⁴)` (ESDIRK3) or `O((ωh)⁶)` (ESDIRK5) per step.
 
 use super::newton::Kinematics;
 use super::*;
 
-/// `γ`, the root of `x³ − 3x² + 3x/2 − 1/6 = 0` in (1/3, 1/2) (Kennedy & Carpenter 2016,
-/// eq. 207: the L-stable third-order SDIRK's diagonal).
-pub const GAMMA: f64 = 0.435_866_521_508_459;
+pub mod tableau;
 
-/// The Butcher matrix `A` (lower triangular, row i = stage i; the last row is `b`):
-/// Kennedy & Carpenter (2016), ESDIRK3(2)4L[2]SA, with `c = (0, 2γ, 3/5, 1)`.
-pub const A: [[f64; 4]; 4] = [
-    [0.0, 0.0, 0.0, 0.0],
-    [GAMMA, GAMMA, 0.0, 0.0],
-    [
-        0.257_648_246_066_427_2,
-        -0.093_514_767_574_886_2,
-        GAMMA,
-        0.0,
-    ],
-    [
-        0.187_641_024_346_723_8,
-        -0.595_297_473_576_955,
-        0.971_789_927_721_772_1,
-        GAMMA,
-    ],
-];
+pub use tableau::{ESDIRK3, ESDIRK5, MAX_STAGES, Tableau};
 
-/// The stability function `R(z) = 1 + z bᵀ(I − zA)⁻¹1` (the step's amplification of
-/// `y' = λy`, `z = λh`), stage by stage since `A` is lower triangular:
-/// `Y_i = (1 + z Σ_{j<i} a_ij Y_j)/(1 − z a_ii)`, `R = Y_4` (stiffly accurate).
-pub fn stability(z: nalgebra::Complex<f64>) -> nalgebra::Complex<f64> {
-    let one = nalgebra::Complex::new(1.0, 0.0);
-    let mut y = [one; S];
-    for i in 0..S {
-        let mut s = one;
-        for j in 0..i {
-            s += z * A[i][j] * y[j];
-        }
-        y[i] = s / (one - z * A[i][i]);
+/// The tableau of an ESDIRK scheme, `None` for the α family.
+pub fn tableau_of(scheme: &Scheme) -> Option<&'static Tableau> {
+    match scheme {
+        Scheme::Esdirk3 => Some(&ESDIRK3),
+        Scheme::Esdirk5 => Some(&ESDIRK5),
+        Scheme::Hht { .. } | Scheme::GeneralizedAlpha { .. } => None,
     }
-    y[S - 1]
 }
 
-/// Number of stages.
-const S: usize = 4;
+/// ESDIRK3's stability function ([`Tableau::stability`]).
+pub fn stability(z: nalgebra::Complex<f64>) -> nalgebra::Complex<f64> {
+    ESDIRK3.stability(z)
+}
+
+/// Most stages.
+const S: usize = MAX_STAGES;
 
 /// Per node `[translation, rotation]`.
 type Pair = [Vector3<f64>; 2];
@@ -90,43 +80,115 @@ pub struct Stages {
     known_v: Vec<Pair>,
     /// `γh` of the step under way.
     gh: f64,
+    /// The scheme's coefficients.
+    tab: &'static Tableau,
     /// Whether the stage being solved meets its constraints at the velocity level (module
     /// docs: the inner stages), with their rows `s γh B(q_i) v_i` in `rows`.
     velocity_level: bool,
     rows: Vec<f64>,
-    /// The trial nodes moved along their velocities by ±ε (central difference of `Φ`).
+    /// The central difference's `ε` of the stage being solved (NaN: not chosen yet).
+    eps: f64,
+    /// The nodes of the elements with multipliers (the joints), each once.
+    joint_nodes: Vec<usize>,
+    /// The trial nodes moved along their velocities by ±ε (central difference of `Φ`);
+    /// only the joints' nodes are moved and read.
     plus: Vec<NodeState>,
     minus: Vec<NodeState>,
 }
 
 impl Stages {
-    pub(super) fn sized(nodes: usize) -> Self {
+    pub(super) fn sized(sys: &System, tab: &'static Tableau) -> Self {
+        let nodes = sys.x0.len();
         let z = [Vector3::zeros(); 2];
+        let mut joint_nodes: Vec<usize> = sys
+            .elements
+            .iter()
+            .filter(|e| e.multipliers() > 0)
+            .flat_map(|e| e.nodes().iter().copied())
+            .collect();
+        joint_nodes.sort_unstable();
+        joint_nodes.dedup();
         Stages {
             vel: vec![[z; S]; nodes],
             acc: vec![[z; S]; nodes],
             known_u: vec![z; nodes],
             known_v: vec![z; nodes],
             gh: 0.0,
+            tab,
             velocity_level: false,
             rows: Vec::new(),
+            eps: f64::NAN,
+            joint_nodes,
             plus: Vec::with_capacity(nodes),
             minus: Vec::with_capacity(nodes),
         }
     }
 }
 
+/// The predicted algebra velocity `Û_i` of stage `i` from the stages `j < i` of the step
+/// under way: the polynomial in `τ = c h` through `(c_j, Û_j)` for the (at most) three
+/// stages `j` nearest to `c_i`, with `Û̇(0) = (v̇_n, Ω̇_n)` added while fewer than three are
+/// known (Hermite at the start). A low degree on purpose: the stiff components of the stages
+/// are not smooth in `c`, and a polynomial through all six of ESDIRK5's stages amplifies
+/// them up to 35-fold at its last stage (its Lebesgue constant there), three nearest 2–4.
+fn predict(tab: &Tableau, i: usize, vel: &[Pair; S], acc0: &Pair, h: f64) -> Pair {
+    let ci = tab.c(i);
+    // The nodes: (c_j, index) of the three stages nearest to c_i.
+    let mut near: [(f64, usize); S] = [(f64::INFINITY, 0); S];
+    for (j, n) in near.iter_mut().enumerate().take(i) {
+        *n = ((tab.c(j) - ci).abs(), j);
+    }
+    near[..i].sort_by(|a, b| a.0.total_cmp(&b.0));
+    let m = i.min(3);
+    let mut out = [Vector3::zeros(); 2];
+    for (comp, o) in out.iter_mut().enumerate() {
+        if m == 1 {
+            // Û(τ) = Û_0 + τ Û̇_0.
+            *o = vel[0][comp] + acc0[comp] * (ci * h);
+        } else if m == 2 && near[..2].iter().any(|n| n.1 == 0) {
+            // Hermite: Û_0, Û̇_0 at 0 and Û_j at c_j (τ in units of h).
+            let j = if near[0].1 == 0 { near[1].1 } else { near[0].1 };
+            let cj = tab.c(j);
+            let d0 = acc0[comp] * h;
+            let slope = (vel[j][comp] - vel[0][comp]) / cj;
+            let curv = (slope - d0) / cj;
+            *o = vel[0][comp] + d0 * ci + curv * (ci * ci);
+        } else {
+            // Lagrange through the m nearest stages.
+            for a in 0..m {
+                let (ja, ca) = (near[a].1, tab.c(near[a].1));
+                let mut l = 1.0;
+                for b in 0..m {
+                    if b != a {
+                        let cb = tab.c(near[b].1);
+                        l *= (ci - cb) / (ca - cb);
+                    }
+                }
+                *o += vel[ja][comp] * l;
+            }
+        }
+    }
+    out
+}
+
 impl Integrator {
-    /// Whether the ESDIRK scheme integrates (else HHT).
-    pub fn is_esdirk3(&self) -> bool {
+    /// Whether an ESDIRK scheme integrates (else the α family).
+    pub fn is_esdirk(&self) -> bool {
         self.esdirk.is_some()
     }
 
-    /// One ESDIRK step of size `h` (module docs): the three implicit stages by Newton,
+    /// The ESDIRK scheme's tableau, `None` for the α family.
+    pub fn esdirk_tableau(&self) -> Option<&'static Tableau> {
+        self.esdirk.as_deref().map(|st| st.tab)
+    }
+
+    /// One ESDIRK step of size `h` (module docs): the implicit stages by Newton,
     /// then the checks of a converged step and the acceptance of the last stage. On
     /// failure the accepted state is unchanged.
     pub(super) fn try_esdirk_step(&mut self, h: f64) -> Result<StepInfo, Failure> {
-        let gh = GAMMA * h;
+        let tab = self.esdirk.as_deref().expect("ESDIRK stages").tab;
+        let (a, last) = (&tab.a, tab.stages - 1);
+        let gh = tab.gamma * h;
         let c_a = 1.0 / (gh * gh);
         let s_new = (c_a * self.mass_ref + self.stiff_ref).max(1e-12);
         let nn = self.sys.n_node_eq;
@@ -143,25 +205,23 @@ impl Integrator {
             st.acc[k][0] = [s.a, s.wd];
         }
         let mut before = 0;
-        for i in 1..S {
-            let ci: f64 = A[i].iter().sum();
+        for i in 1..=last {
+            let ci = tab.c(i);
             let st = self.esdirk.as_deref_mut().expect("ESDIRK stages");
             for (k, s) in self.nodes.iter().enumerate() {
                 let (mut ku, mut kv) = ([Vector3::zeros(); 2], [s.v, s.w]);
                 for j in 0..i {
                     for c in 0..2 {
-                        ku[c] += st.vel[k][j][c] * (h * A[i][j]);
-                        kv[c] += st.acc[k][j][c] * (h * A[i][j]);
+                        ku[c] += st.vel[k][j][c] * (h * a[i][j]);
+                        kv[c] += st.acc[k][j][c] * (h * a[i][j]);
                     }
                 }
                 st.known_u[k] = ku;
                 st.known_v[k] = kv;
-                // Predictor: constant accelerations from the start.
-                let t = ci * h;
-                self.u[k] = [
-                    s.v * t + s.a * (0.5 * t * t),
-                    s.w * t + s.wd * (0.5 * t * t),
-                ];
+                // Predictor: the stage's algebra velocity extrapolated from the stages
+                // solved so far ([`predict`]), `U_i = h Σ_{j<i} a_ij Û_j + γh Û_i`.
+                let pred = predict(tab, i, &st.vel[k], &st.acc[k][0], h);
+                self.u[k] = [ku[0] + pred[0] * gh, ku[1] + pred[1] * gh];
             }
             let ctx = EvalContext {
                 t: self.t + ci * h,
@@ -176,9 +236,10 @@ impl Integrator {
             self.esdirk
                 .as_deref_mut()
                 .expect("ESDIRK stages")
-                .velocity_level = i < S - 1;
+                .velocity_level = i < last;
+            self.esdirk.as_deref_mut().expect("ESDIRK stages").eps = f64::NAN;
             let (iter, rel, history, fref) = self.newton_solve(h, &ctx, Kinematics::Stage)?;
-            if i == S - 1 {
+            if i == last {
                 let mut info = self.finish_step(h, &ctx, iter, rel, history, fref)?;
                 self.stats.newton_iterations += u64::from(before);
                 info.iterations += before;
@@ -239,13 +300,32 @@ impl Integrator {
         st.rows.clear();
         st.rows.resize(n - nn, 0.0);
         // At rest the difference is along time alone (a driver's ∂Φ/∂t), over 1e-4 of the step.
-        let eps = if vmax > 0.0 {
+        let eps0 = if vmax > 0.0 {
             1e-4 / vmax
         } else {
             1e-4 * st.gh
         };
-        moved_along_velocities(&self.trial, eps, &mut st.plus);
-        moved_along_velocities(&self.trial, -eps, &mut st.minus);
+        if st.eps.is_nan() {
+            st.eps = eps0;
+        }
+        let eps = st.eps;
+        // Only the joints' nodes move: the rows are the joints' alone.
+        if st.plus.len() != self.trial.len() {
+            st.plus.clone_from(&self.trial);
+            st.minus.clone_from(&self.trial);
+        }
+        moved_some_along_velocities(
+            &self.trial,
+            eps,
+            st.joint_nodes.iter().copied(),
+            &mut st.plus,
+        );
+        moved_some_along_velocities(
+            &self.trial,
+            -eps,
+            st.joint_nodes.iter().copied(),
+            &mut st.minus,
+        );
         // Time moves with the state, so a driven (rheonomic) constraint's rows are its
         // total derivative `B v + ∂Φ/∂t`.
         let at = |dt: f64| EvalContext {

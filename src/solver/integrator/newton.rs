@@ -155,6 +155,15 @@ impl Integrator {
         // (A step of the same size within round-off: fixed steps coming back to their grid after
         // an event are differences of times.)
         // (lu_step is NaN when no factorisation is valid: the test below is then false.)
+        // A stage of the ESDIRK schemes keeps its matrix down to a contraction of 1/2: its
+        // step moves the state 5–25 HHT steps' worth, so the joints' rows of a matrix kept
+        // from an earlier step converge linearly at ~0.1–0.5 while the node rows converge at
+        // ~1e-3; rebuilding at 1/4 cost ESDIRK5 1.29 factorisations per step on flexible1 at
+        // H = 3.90625e-4 s, at 1/2 0.83, for 11 % more iterations and ~8 % less CPU.
+        let contraction = match kin {
+            Kinematics::Hht => CONTRACTION,
+            Kinematics::Stage => STAGE_CONTRACTION,
+        };
         let same_step = (self.lu_step - h).abs() <= 1e-9 * h;
         let mut tangent = !self.newton.modified || !same_step;
         let mut prev_rel = f64::INFINITY;
@@ -228,9 +237,19 @@ impl Integrator {
             // (`tests/accuracy.rs`), for no more iterations elsewhere.
             let increments_done =
                 last_inc <= 1e-3 * self.newton.tol_increment || last_inc > 0.5 * prev_inc;
+            // A stage of the ESDIRK schemes also stops when the kept matrix's contraction
+            // `ρ` (the residual's, as a proxy) bounds what remains of the error,
+            // `ρ/(1 − ρ)` of the last increment, below the same 1/1000 of the increment
+            // tolerance (Hairer & Wanner II, § IV.8, eq. 8.10): a stage that contracted by
+            // 1e-3 per iteration needs no extra iteration to show it stagnates.
+            let rho = rel / prev_rel;
+            let contracted = kin == Kinematics::Stage
+                && rho < 0.5
+                && rho / (1.0 - rho) * last_inc <= 1e-3 * self.newton.tol_increment;
             let polished = iter == 0
                 || fresh
                 || rel <= 0.01 * self.newton.tol_residual
+                || contracted
                 || (rel > 0.5 * prev_rel && increments_done);
             let converged = rel <= self.newton.tol_residual
                 && cn <= tol_len
@@ -246,8 +265,11 @@ impl Integrator {
             // past half of the iterations allowed it is rebuilt anyway: a linear rate that
             // passes the test could still spend them all on polishing, where a fresh Newton
             // step converges quadratically.
+            // (A stage whose residual already meets the tolerance is only polishing: its
+            // stagnation at the round-off floor is no reason to rebuild.)
             let slow = iter > 0
-                && (rel > CONTRACTION * prev_rel || 2 * iter >= self.newton.max_iterations);
+                && !(kin == Kinematics::Stage && rel <= self.newton.tol_residual)
+                && (rel > contraction * prev_rel || 2 * iter >= self.newton.max_iterations);
             if !tangent && slow {
                 // The kept matrix no longer contracts well: rebuild it here (the residual
                 // is assembled again with it; `rel` above was finite, or we returned).
