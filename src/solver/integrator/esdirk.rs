@@ -2,8 +2,8 @@
 //! index-3 constraints met at every step's end: ESDIRK3 and ESDIRK5.
 //!
 //! # The schemes
-//! Kennedy & Carpenter's (NASA/TM-2016-219173) ESDIRK3(2)4L[2]SA (§ 5.2.1: four stages,
-//! `γ = 0.4358665215084590`) and ESDIRK5(4)7L[2]SA2 (§ 7.2.2: seven stages, `γ = 23/125`),
+//! Kennedy & Carpenter's (NASA/TM-2016-219173) `ESDIRK3(2)4L[2]SA` (§ 5.2.1: four stages,
+//! `γ = 0.4358665215084590`) and `ESDIRK5(4)7L[2]SA2` (§ 7.2.2: seven stages, `γ = 23/125`),
 //! their tableaux in [`tableau`]: the first stage explicit, the others with the same
 //! diagonal `γ`, stage order 2, L-stable, `b = A`'s last row. They are applied to the
 //! first-order form of the equations of motion in the local coordinates of the group about
@@ -11,7 +11,7 @@
 //! Numerica 9, § 5):
 //! - per node, `x_i = x_n + U_i`, `R_i = R_n exp(Ũ_i)`, `U_i = h Σ_j a_ij Û_j`, where the
 //!   stage's algebra velocity is `Û_j = v_j` (translation) and `Û_j = T(U_j)⁻¹ Ω_j`
-//!   (rotation: `Ω = T(U) U̇`, paper eq. [3], so the RK stages see the exact `dexp⁻¹`);
+//!   (rotation: `Ω = T(U) U̇`, paper eq. (3), so the RK stages see the exact `dexp⁻¹`);
 //! - `v_i = v_n + h Σ_j a_ij v̇_j`, `Ω_i = Ω_n + h Σ_j a_ij Ω̇_j` (material frame);
 //! - at each implicit stage, equilibrium `r(q_i, v_i, v̇_i, λ_i) = 0` at `t_n + c_i h`; the
 //!   inner stages meet the constraints at the velocity level, `B(q_i) v_i + ∂Φ/∂t = 0` (an
@@ -29,7 +29,7 @@
 //! stage of the previous step (or [`Integrator::consistent_accelerations`] at a start or
 //! a contact's restart) solved, so the scheme is one-step in `(q, v)` and keeps no history
 //! across steps (a checkpoint needs nothing more than HHT's). Each stage's Newton starts
-//! from [`predict`]'s extrapolation of the stages already solved in the same step.
+//! from `predict`'s extrapolation of the stages already solved in the same step.
 //!
 //! Newton's unknown at stage i is `U_i`; then `∂v_i/∂U_i = 1/(γh)` and
 //! `∂v̇_i/∂U_i = 1/(γh)²` exactly for translations (and to `O(|U|)` for rotations, where

@@ -3,7 +3,7 @@
 //! (`a_21 = γ`), stiffly accurate (`b` = the last row of `A`), L-stable.
 //!
 //! The coefficients of the fifth-order tableau are the paper's rationals (its § 7.2.2
-//! ESDIRK5(4)7L[2]SA2, as SUNDIALS' ARKODE lists them), with `a_i1 = c_i − Σ_{j>1} a_ij` and `b_1 = 1 − Σ_{j>1} b_j` evaluated in exact
+//! `ESDIRK5(4)7L[2]SA2`, as SUNDIALS' ARKODE lists them), with `a_i1 = c_i − Σ_{j>1} a_ij` and `b_1 = 1 − Σ_{j>1} b_j` evaluated in exact
 //! rational arithmetic and rounded once to `f64`. The unit tests check every order condition
 //! up to the claimed order (and that the next order fails), the stage order and `R(∞)`.
 
@@ -30,7 +30,7 @@ pub struct Tableau {
 /// Carpenter 2016, eq. 207: the L-stable third-order SDIRK's diagonal).
 const G3: f64 = 0.435_866_521_508_459;
 
-/// ESDIRK3(2)4L[2]SA (Kennedy & Carpenter 2016, § 5.2.1): four stages, `c = (0, 2γ, 3/5, 1)`.
+/// `ESDIRK3(2)4L[2]SA` (Kennedy & Carpenter 2016, § 5.2.1): four stages, `c = (0, 2γ, 3/5, 1)`.
 pub const ESDIRK3: Tableau = Tableau {
     name: "esdirk3",
     order: 3,
@@ -63,7 +63,7 @@ pub const ESDIRK3: Tableau = Tableau {
     ],
 };
 
-/// ESDIRK5(4)7L[2]SA2 (Kennedy & Carpenter 2016, § 7.2.2): seven stages, `γ = 23/125`,
+/// `ESDIRK5(4)7L[2]SA2` (Kennedy & Carpenter 2016, § 7.2.2): seven stages, `γ = 23/125`,
 /// `c = (0, 46/125, 7121331996143/11335814405378, 49/353, 3706679970760/5295570149437,
 /// 347/382, 1)`.
 pub const ESDIRK5: Tableau = Tableau {
