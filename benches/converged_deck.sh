@@ -8,7 +8,7 @@
 #   benches/converged_deck.sh [OUT] [ROUNDS] [CANDIDATES...]
 #
 # A candidate is NAME:STEP:INTEGRATOR[:EVERY] with INTEGRATOR one of hht, ga0.8, ga0.9,
-# esdirk (default: the list below). Each candidate runs once with output every step (for its
+# esdirk (ESDIRK3), esdirk5 (default: the list below). Each candidate runs once with output every step (for its
 # error: benches/converged_deck.py interpolates the reference at the run's instants) and
 # ROUNDS times with output every EVERY steps (timed; default: 1e-3 s, which STEP must then
 # divide; STEP must divide the END, 1.5 s). The reference is made once in OUT (as benches/esdirk_ratio.sh does) or
@@ -24,6 +24,7 @@ cands=("$@")
   ga8_16:1.5625e-5:ga0.8 ga8_20:2e-5:ga0.8 ga8_25:2.5e-5:ga0.8
   ga9_16:1.5625e-5:ga0.9 ga9_1875:1.875e-5:ga0.9:80 ga9_20:2e-5:ga0.9 ga9_25:2.5e-5:ga0.9
   es25:2.5e-5:esdirk es31:3.125e-5:esdirk es40:4e-5:esdirk
+  es5_3125:3.125e-4:esdirk5:4 es5_3906:3.90625e-4:esdirk5:4 es5_4688:4.6875e-4:esdirk5:4
 )
 bin=target/release/mecano-rs
 mkdir -p "$out"
@@ -45,6 +46,7 @@ mk() { # name step integrator every suffix
     hht) card="ALPHA -0.1" ;;
     ga*) card="GENALPHA RHOINF ${3#ga}" ;;
     esdirk) card="ESDIRK3" ;;
+    esdirk5) card="ESDIRK5" ;;
     *) echo "unknown integrator $3" >&2; exit 2 ;;
   esac
   sed -e "s/^ANALYSIS DYNAMIC .*/ANALYSIS DYNAMIC $card STEP $2 END 1.5/" \

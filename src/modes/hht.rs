@@ -164,12 +164,13 @@ pub fn resolution(scheme: &Scheme, h: f64, frequency_hz: f64) -> Resolution {
 }
 
 /// The schemes whose action on each mode `--check` and a run's summary set side by side:
-/// the deck's first, then each of HHT, generalized-α and ESDIRK3 that is not the deck's.
+/// the deck's first, then each of HHT, generalized-α, ESDIRK3 and ESDIRK5 that is not the
+/// deck's.
 /// HHT and generalized-α at the deck's spectral radius at infinity `ρ∞` where it is in
 /// their range (the same damping of the unresolved modes, so that the rows differ in what
 /// they do to the resolved ones): HHT with `α = (ρ∞ − 1)/(ρ∞ + 1)` when `ρ∞ ≥ ½`, else
 /// the default `α = −0.1`; generalized-α with the deck's `ρ∞`, or HHT's when the deck is
-/// ESDIRK3 (`ρ∞ = 0`). ESDIRK3 has no parameter.
+/// an ESDIRK scheme (`ρ∞ = 0`). The ESDIRK schemes have no parameter.
 pub fn compared_schemes(deck: &Scheme) -> Vec<Scheme> {
     let hht = match *deck {
         Scheme::Hht { .. } => *deck,
@@ -193,7 +194,7 @@ pub fn compared_schemes(deck: &Scheme) -> Vec<Scheme> {
         },
     };
     let mut v = vec![*deck];
-    for s in [hht, ga, Scheme::Esdirk3] {
+    for s in [hht, ga, Scheme::Esdirk3, Scheme::Esdirk5] {
         if s.name() != deck.name() {
             v.push(s);
         }
@@ -261,7 +262,10 @@ mod tests {
                 },
                 Scheme::GeneralizedAlpha { rho_inf: rho },
             ];
-            assert_eq!(compared_schemes(&ga), vec![ga, hht, Scheme::Esdirk3]);
+            assert_eq!(
+                compared_schemes(&ga),
+                vec![ga, hht, Scheme::Esdirk3, Scheme::Esdirk5]
+            );
             for w in [0.05, 0.2, 0.5] {
                 let (a, b) = (spectral(&hht, w), spectral(&ga, w));
                 assert!(b.damping < a.damping, "ρ∞ {rho}, Ω {w}: {b:?} vs {a:?}");
@@ -273,7 +277,7 @@ mod tests {
         let ga = Scheme::GeneralizedAlpha { rho_inf: 0.2 };
         assert_eq!(
             compared_schemes(&ga),
-            vec![ga, Scheme::default(), Scheme::Esdirk3]
+            vec![ga, Scheme::default(), Scheme::Esdirk3, Scheme::Esdirk5]
         );
     }
 

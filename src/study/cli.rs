@@ -22,7 +22,7 @@ pub struct StudyArgs {
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub alpha: Vec<f64>,
     /// Time integrators of the fixed-step runs, comma-separated, one ladder of steps and one
-    /// line of the diagram each: `hht[:α]`, `genalpha[:ρ∞]`, `esdirk3` (default: the deck's).
+    /// line of the diagram each: `hht[:α]`, `genalpha[:ρ∞]`, `esdirk3`, `esdirk5` (default: the deck's).
     /// A bare `hht` is α = −0.1 and a bare `genalpha` ρ∞ = 0.8; give another value after a
     /// colon, e.g. `hht:-0.3,genalpha:0.5`. The first one's finest run is the reference and
     /// its scheme the adaptive runs'. A space–time study (several `--refine`, or `--order`)
