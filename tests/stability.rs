@@ -104,6 +104,35 @@ fn rise(rec: &Rec) -> f64 {
     rec.e.iter().map(|e| e - rec.e[0]).fold(f64::MIN, f64::max)
 }
 
+/// The energy rise a case is judged on. The α schemes: [`rise`]. The stage schemes
+/// (ESDIRK3, ESDIRK5) keep the resolved motion's energy to O((ωh)⁴) or better, so the
+/// balance's trapezoidal work of a torque pulse errs visibly while it acts (up to
+/// 1e-2 of the kinetic energy: the bound `quadrature_bound` of tests/esdirk.rs, which judges
+/// that part): for them the rise is measured from the end of the decks' pulse (0.02 s), after
+/// which only gravity acts, whose work is in `E`.
+fn judged_rise(rec: &Rec) -> f64 {
+    if !scheme_override().is_some_and(|s| s.is_esdirk()) {
+        return rise(rec);
+    }
+    let Some(k) = rec.t.iter().position(|t| *t >= 0.02) else {
+        return rise(rec);
+    };
+    rec.e[k..]
+        .iter()
+        .map(|e| e - rec.e[k])
+        .fold(f64::MIN, f64::max)
+}
+
+/// Newton solves per step: one for the α schemes, the implicit stages for ESDIRK3 (3) and
+/// ESDIRK5 (6), so that the per-solve bounds of the suite hold for every scheme.
+fn solves_per_step() -> f64 {
+    match scheme_override() {
+        Some(Scheme::Esdirk3) => 3.0,
+        Some(Scheme::Esdirk5) => 6.0,
+        _ => 1.0,
+    }
+}
+
 fn max_of(v: &[f64]) -> f64 {
     v.iter().copied().fold(0.0, f64::max)
 }
@@ -136,10 +165,10 @@ fn stiff_bars_converge_at_the_steel_step_and_agree_with_rigid_bodies() {
             },
         );
         assert!(r.failure.is_none(), "{d}: {}", r.failure.unwrap());
-        let it = it_per_step(&r);
+        let it = it_per_step(&r) / solves_per_step();
         let fact = r.stats.factorizations as f64 / r.stats.steps.max(1) as f64;
         println!(
-            "{d}: {} steps, {} cut, {it:.2} it/step, {fact:.2} factorisations/step, max violation {:.1e}, {:.1} s",
+            "{d}: {} steps, {} cut, {it:.2} it/solve, {fact:.2} factorisations/step, max violation {:.1e}, {:.1} s",
             r.stats.steps,
             r.stats.rejected_steps,
             max_of(&rec.viol),
@@ -254,7 +283,7 @@ fn stiff_contact_runs_and_never_creates_energy() {
             set_steps(&mut model, 1e-4, 0.6, None);
             let (r, rec) = run(&model, Rec::default());
             assert!(r.failure.is_none(), "{d} k = {k:e}: {}", r.failure.unwrap());
-            let (up, kmax) = (rise(&rec), max_of(&rec.kin));
+            let (up, kmax) = (judged_rise(&rec), max_of(&rec.kin));
             println!(
                 "{d} k = {k:.0e}: {} steps ({} refused), {:.2} it/step, rise {:.1e} of max kinetic {kmax:.1} J, {:.1} s",
                 r.stats.steps,
@@ -400,9 +429,9 @@ fn long_run_energy_never_increases_with_damping_and_stays_bounded() {
             loss / kmax
         );
         assert!(
-            rise(&rec) <= 1e-6 * kmax,
-            "alpha {alpha}: energy rose above its initial value by {:e} J",
-            rise(&rec)
+            judged_rise(&rec) <= 1e-6 * kmax,
+            "{label}: energy rose above its initial value by {:e} J",
+            judged_rise(&rec)
         );
     }
 }

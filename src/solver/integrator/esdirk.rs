@@ -245,6 +245,7 @@ impl Integrator {
                 info.iterations += before;
                 return Ok(info);
             }
+            let history = self.stage_events(h, ci * h, &ctx, history, fref)?;
             self.history = history;
             before += iter;
             let st = self.esdirk.as_deref_mut().expect("ESDIRK stages");
@@ -255,6 +256,48 @@ impl Integrator {
             }
         }
         unreachable!("the last stage returns")
+    }
+
+    /// Event control of an inner stage: the elements' step limits (a contact's touch,
+    /// release and impact resolution, `Element::step_limit`) from the step's start to the
+    /// stage's state, over `[t, t + c_i h]` (`ch = c_i h`). The step's end alone is not
+    /// enough for a stage scheme: a stage may sit deep in a contact that both ends of the
+    /// step are clear of (a step of 1e-3 s over the steel clearance impact of
+    /// `decks/stab_clearance_impact.dat`, 1e-4 s long, ended with 0.3 J of kinetic energy
+    /// out of 5.0 with ESDIRK3 and created 33 J with ESDIRK5, and neither end saw it). A
+    /// refusal here refuses the whole step, to retry at the length the element asks for
+    /// (measured from the step's start, as at the end); at the smallest step a landing
+    /// refusal is waived and an unresolved one stops the run, as in `finish_step`.
+    fn stage_events(
+        &mut self,
+        h: f64,
+        ch: f64,
+        ctx: &EvalContext,
+        history: Vec<f64>,
+        fref: f64,
+    ) -> Result<Vec<f64>, Failure> {
+        let sub = EvalContext { h: ch, ..*ctx };
+        let (mut refuse, mut unresolved) = (None::<f64>, None::<(f64, crate::model::ElementId)>);
+        for e in self.sys.elements.iter() {
+            let Some(lim) = e.step_limit(&sub, &self.nodes, &self.trial) else {
+                continue;
+            };
+            if ch > lim.accept_up_to {
+                refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
+                if lim.unresolved && unresolved.is_none() {
+                    unresolved = Some((lim.retry, e.id()));
+                }
+            }
+        }
+        if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
+            let retry = retry.max(self.event_floor).min(0.999 * h);
+            return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+        }
+        if let Some((asks, element)) = unresolved {
+            let why = FailureReason::EventUnresolved { element, asks };
+            return Err(self.failure(h, why, history, fref));
+        }
+        Ok(history)
     }
 
     /// The trial state of the stage being solved from Newton's increment `u` (module
