@@ -90,6 +90,11 @@ pub struct Stages {
     eps: f64,
     /// The nodes of the elements with multipliers (the joints), each once.
     joint_nodes: Vec<usize>,
+    /// Whether an element's constraint depends on time (a driver): its `∂Φ/∂t` enters the
+    /// inner stages' velocity rows.
+    rheonomic: bool,
+    /// Scratch of the time difference of the rows.
+    time_rows: Vec<f64>,
     /// The trial nodes moved along their velocities by ±ε (central difference of `Φ`);
     /// only the joints' nodes are moved and read.
     plus: Vec<NodeState>,
@@ -119,6 +124,8 @@ impl Stages {
             rows: Vec::new(),
             eps: f64::NAN,
             joint_nodes,
+            rheonomic: sys.elements.iter().any(|e| e.rheonomic()),
+            time_rows: Vec::new(),
             plus: Vec::with_capacity(nodes),
             minus: Vec::with_capacity(nodes),
         }
@@ -342,35 +349,20 @@ impl Integrator {
             .fold(0.0f64, |m, s| m.max(s.v.norm() / l).max(s.w.norm()));
         st.rows.clear();
         st.rows.resize(n - nn, 0.0);
-        // At rest the difference is along time alone (a driver's ∂Φ/∂t), over 1e-4 of the step.
-        let eps0 = if vmax > 0.0 {
-            1e-4 / vmax
-        } else {
-            1e-4 * st.gh
-        };
+        // `B v`: the nodes moved along their velocities by ±ε at the stage's time, ε|v| =
+        // 1e-4 L_ref. A driver's `∂Φ/∂t`: a second difference in time alone, over
+        // ±ε_t = ±1e-2 γh, so that it reads the driver's law where the stage is (moving
+        // time with the state by ε, as until this session, read a HAVERSINE law up to
+        // seconds past its end near rest, where it is flat: driven_arm.dat's velocities were
+        // 0.74 m/s off; one ε for both, capped, either stalled Newton on round-off — ε|v| of
+        // 1e-8 m — or kept a truncation error of 1e-3 m/s). Truncation of the time part
+        // (1e-2 γh)² f‴/6; its round-off ε_mach |f|/ε_t, 1e-7 of the rate at t = 10 s for
+        // h = 1e-5 s.
+        let eps0 = if vmax > 0.0 { 1e-4 / vmax } else { 0.0 };
         if st.eps.is_nan() {
             st.eps = eps0;
         }
         let eps = st.eps;
-        // Only the joints' nodes move: the rows are the joints' alone.
-        if st.plus.len() != self.trial.len() {
-            st.plus.clone_from(&self.trial);
-            st.minus.clone_from(&self.trial);
-        }
-        moved_some_along_velocities(
-            &self.trial,
-            eps,
-            st.joint_nodes.iter().copied(),
-            &mut st.plus,
-        );
-        moved_some_along_velocities(
-            &self.trial,
-            -eps,
-            st.joint_nodes.iter().copied(),
-            &mut st.minus,
-        );
-        // Time moves with the state, so a driven (rheonomic) constraint's rows are its
-        // total derivative `B v + ∂Φ/∂t`.
         let at = |dt: f64| EvalContext {
             t: ctx.t + dt,
             ..*ctx
@@ -378,14 +370,51 @@ impl Integrator {
         // The constraint rows alone: the elements without multipliers (beams, contacts)
         // are not evaluated at the moved states (and a contact's per-attempt memory is not
         // touched by evaluations at other times).
-        self.sys
-            .assemble_constraint_rows(&at(eps), &st.plus, &self.trial_lambda);
-        st.rows.copy_from_slice(&self.sys.rhs[nn..]);
-        self.sys
-            .assemble_constraint_rows(&at(-eps), &st.minus, &self.trial_lambda);
-        let c = st.gh / (2.0 * eps);
-        for (r, m) in st.rows.iter_mut().zip(&self.sys.rhs[nn..]) {
-            *r = (*r - m) * c;
+        if eps > 0.0 {
+            // Only the joints' nodes move: the rows are the joints' alone.
+            if st.plus.len() != self.trial.len() {
+                st.plus.clone_from(&self.trial);
+                st.minus.clone_from(&self.trial);
+            }
+            moved_some_along_velocities(
+                &self.trial,
+                eps,
+                st.joint_nodes.iter().copied(),
+                &mut st.plus,
+            );
+            moved_some_along_velocities(
+                &self.trial,
+                -eps,
+                st.joint_nodes.iter().copied(),
+                &mut st.minus,
+            );
+            self.sys
+                .assemble_constraint_rows(&at(0.0), &st.plus, &self.trial_lambda);
+            st.rows.copy_from_slice(&self.sys.rhs[nn..]);
+            self.sys
+                .assemble_constraint_rows(&at(0.0), &st.minus, &self.trial_lambda);
+            let c = st.gh / (2.0 * eps);
+            for (r, m) in st.rows.iter_mut().zip(&self.sys.rhs[nn..]) {
+                *r = (*r - m) * c;
+            }
+        }
+        if st.rheonomic {
+            let et = 1e-2 * st.gh;
+            self.sys
+                .assemble_constraint_rows(&at(et), &self.trial, &self.trial_lambda);
+            st.time_rows.clear();
+            st.time_rows.extend_from_slice(&self.sys.rhs[nn..]);
+            self.sys
+                .assemble_constraint_rows(&at(-et), &self.trial, &self.trial_lambda);
+            let c = st.gh / (2.0 * et);
+            for ((r, p), m) in st
+                .rows
+                .iter_mut()
+                .zip(&st.time_rows)
+                .zip(&self.sys.rhs[nn..])
+            {
+                *r += (p - m) * c;
+            }
         }
     }
 

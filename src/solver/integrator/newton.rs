@@ -271,10 +271,7 @@ impl Integrator {
             // past half of the iterations allowed it is rebuilt anyway: a linear rate that
             // passes the test could still spend them all on polishing, where a fresh Newton
             // step converges quadratically.
-            // (A stage whose residual already meets the tolerance is only polishing: its
-            // stagnation at the round-off floor is no reason to rebuild.)
             let slow = iter > 0
-                && !(kin == Kinematics::Stage && rel <= self.newton.tol_residual)
                 && (rel > contraction * prev_rel || 2 * iter >= self.newton.max_iterations);
             if !tangent && slow {
                 // The kept matrix no longer contracts well: rebuild it here (the residual
