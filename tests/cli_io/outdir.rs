@@ -3,7 +3,7 @@
 //! releases when its holder dies); a new run removes the files of the previous run there
 //! (its manifest) and refuses files of anyone else unless `--force`.
 
-mod common;
+use crate::common;
 
 use std::fs::{self, File, OpenOptions};
 use std::os::fd::AsRawFd;

@@ -1,6 +1,6 @@
 //! `mecano-rs plot`: the three figures from a short real run, and clear errors (exit 2).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -4,7 +4,7 @@
 //! and a restart gives the same `histories.nc` byte for byte; an output that cannot be
 //! opened stops the run before its first step with exit 2.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::{Command, Output};

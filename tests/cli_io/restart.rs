@@ -9,7 +9,7 @@
 //! handlers) or, for signals from outside, frozen with SIGSTOP first so that the signal
 //! lands during the run whatever the machine's speed. Each run costs ~0.3 s of CPU.
 
-mod common;
+use crate::common;
 
 use common::{TempDir, require_failpoints};
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `OUTPUT … VTK`: a short run of the pendulum writes a ParaView series whose `.pvd`
 //! references existing `.vtu` files with one point per node and one line per beam.
 
-mod common;
+use crate::common;
 
 use mecano::output::vtk::{PVD_NAME, VTK_LINE};
 

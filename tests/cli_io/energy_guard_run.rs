@@ -17,7 +17,7 @@
 //! What fails without the guard: the resumed run exits 1 at 20.7315 s (measured with the
 //! code before the guard, `docs/stability.md`), so `complete` is never reached.
 
-mod common;
+use crate::common;
 
 use common::TempDir;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! each mode, `mecano-rs plot modes`, and the sweep quantity of a mode's frequency and
 //! damping — each read back and checked against `modes.csv` / `modes_shapes.csv`.
 
-mod common;
+use crate::common;
 
 use common::TempDir;
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! The command line: a deck with errors exits with code 2 and writes nothing.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

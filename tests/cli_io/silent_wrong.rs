@@ -3,7 +3,7 @@
 //! without the work to pay for it is refused (the energy guard); every failure writes the
 //! same complete record.
 
-mod common;
+use crate::common;
 
 use mecano::deck::parse_deck;
 use mecano::output::History;
@@ -11,7 +11,7 @@ use mecano::solver::{self, energy_guard};
 use std::path::Path;
 use std::process::Command;
 
-const PENDULUM: &str = include_str!("../decks/pendulum.dat");
+const PENDULUM: &str = include_str!("../../decks/pendulum.dat");
 
 /// The pendulum with `from` replaced by `to` in its text and cut to `end` seconds.
 fn pendulum(from: &str, to: &str, end: &str) -> String {

@@ -2,7 +2,7 @@
 //! where it was planted, with the exit codes of the README (0 pass, 1 over tolerance,
 //! 2 bad input).
 
-mod common;
+use crate::common;
 
 use common::TempDir;
 use std::path::{Path, PathBuf};

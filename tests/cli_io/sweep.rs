@@ -3,7 +3,7 @@
 //! that skip finished cases and restart interrupted ones, failed cases recorded, random
 //! plans, a 10,000-case plan listed and emitted without running, and bad input (exit 2).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
