@@ -3,7 +3,7 @@
 //! LU) and computing the initial accelerations never panics — it succeeds or returns an
 //! error (issue: hard cases stay numerically stable, item 3).
 
-mod common;
+use crate::common;
 
 use mecano::deck::parse_deck;
 use mecano::solver;

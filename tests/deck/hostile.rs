@@ -4,7 +4,7 @@
 //! written with an unvalidated value; a huge field is refused fast with a short message;
 //! model errors point at their card; `sweep` reports failed cases and unknown names.
 
-mod common;
+use crate::common;
 
 use mecano::deck::{DeckErrorKind as K, DeckErrors, ECHO_CHARS, limits, load_deck, parse_deck};
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 use mecano::deck::parse_deck;
 use proptest::prelude::*;
 
-const DECK: &str = include_str!("../decks/pendulum.dat");
+const DECK: &str = include_str!("../../decks/pendulum.dat");
 
 /// Words and fragments likely to reach deep into the parser.
 const PIECES: &[&str] = &[

@@ -1,7 +1,7 @@
 //! `grammar.md` documents every keyword the parser accepts, documents nothing the parser
 //! does not accept, and its examples are valid decks.
 
-mod common;
+use crate::common;
 
 use mecano::deck::{KEYWORDS, parse_deck};
 use std::collections::BTreeSet;
