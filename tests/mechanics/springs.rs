@@ -17,7 +17,7 @@
 //! from the closed form `δ = 2πζ/√(1−ζ²)`; a measured decrement is held to `|δ_h − δ|`
 //! plus its measurement error (peaks by a parabola through three samples: 1e-5 relative).
 
-mod common;
+use crate::common;
 
 use mecano::deck::{parse_deck, parse_deck_with};
 use mecano::model::Model;

@@ -10,7 +10,7 @@
 //! relative error ≲ 3e-6; the tests allow 1e-4 of the torque's largest magnitude, and
 //! check that halving h reduces the error (the order, not a tuned number).
 
-mod common;
+use crate::common;
 
 use common::deck;
 use mecano::deck::parse_deck;

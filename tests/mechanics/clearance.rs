@@ -4,7 +4,7 @@
 //! rolling under gravity (energy balance), the bad input, and the slider-crank of Flores &
 //! Ambrósio (2004) with and without clearance (decks/benchmarks/).
 
-mod common;
+use crate::common;
 
 use common::deck;
 use common::impact::{impact_ode, lankarani_nikravesh};
@@ -88,8 +88,9 @@ fn impact(rec: &Rec, c: f64) -> (f64, f64) {
 /// impact: error ~1e-15). The law's effective restitution is not `e`: the ODE gives 0.8215
 /// here, and the test checks that it differs from e by far more than the tolerance.
 /// Tolerance: the trapezoidal rule (α = 0) integrates a dissipative impact with a relative
-/// error of its logarithmic decrement of order (ωh)²/4 (the bound of `tests/contact.rs`),
-/// with ωh = π/N at N = 100 steps per impact resolved at the local contact frequency:
+/// error of its logarithmic decrement of order (ωh)²/4 (the bound of
+/// `tests/mechanics/contact.rs`), with ωh = π/N at N = 100 steps per impact resolved at the
+/// local contact frequency:
 /// `|ln e_ref| (π/N)²/4`, plus the touch landing's 1e-4 of a step (EVENT_TOL).
 #[test]
 fn lankarani_nikravesh_restitution_matches_the_impact_ode() {
@@ -124,7 +125,7 @@ fn lankarani_nikravesh_restitution_matches_the_impact_ode() {
 /// rebound against the closed form of a clipped linear spring–dashpot: with σ = ζω,
 /// ω_d = ω√(1 − ζ²), the force `k δ + c δ̇` vanishes at `ω_d t* = π − atan(2σω_d/(ω_d² − σ²))`
 /// and the journal leaves with `e = −e^{−σt*}(cos ω_d t* − (σ/ω_d) sin ω_d t*)`. Tolerance
-/// `πζ(ωh)²/4` (tests/contact.rs) at ωh = π/N, plus the landing's 1e-4.
+/// `πζ(ωh)²/4` (tests/mechanics/contact.rs) at ωh = π/N, plus the landing's 1e-4.
 #[test]
 fn kelvin_voigt_restitution_matches_the_clipped_closed_form() {
     let mut model = deck("clearance_impact.dat");

@@ -5,7 +5,7 @@
 //! Initial velocities are set with `Integrator::set_velocity` between `solver::prepare` and
 //! `solver::run_prepared` (the decks have no INITIAL section yet).
 
-mod common;
+use crate::common;
 
 use mecano::model::{ElementKind, Model, NodeId};
 use mecano::solver::{self, Observer, Snapshot};

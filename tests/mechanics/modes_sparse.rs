@@ -1,7 +1,7 @@
 //! The sparse shift-invert Lanczos path of `mecano-rs modes` (issue 24 §3; src/modes/sparse.rs)
 //! against the dense path on the same models, and against the cantilever's closed form.
 
-mod common;
+use crate::common;
 
 use mecano::app::modes::{About, analyse_model_using, load};
 use mecano::model::Model;

@@ -2,7 +2,7 @@
 //! rotations, the geometrically exact BEAM, HHT and Newton). Every case runs a deck from
 //! `decks/`; tolerances are derived in the comments next to them.
 
-mod common;
+use crate::common;
 
 use common::deck;
 use mecano::elements::NodeState;
