@@ -5,8 +5,8 @@
 //! Nodes 12 and 23 at the instants t = 0, 5 ms, …, 2 s (401 rows): position, rotation
 //! vector, velocity, acceleration, interpolated between the accepted steps that bracket each
 //! instant (linearly; the rotation on the group). Regenerate them with
-//! `MECANO_REGEN_GOLDEN=1 cargo test --release --test pendulum` (see tests/golden/README.md:
-//! a change of them must be justified in its commit).
+//! `MECANO_REGEN_GOLDEN=1 cargo test --release --test validation pendulum::` (see
+//! tests/golden/README.md: a change of them must be justified in its commit).
 //!
 //! # Where they are compared, and how closely
 //! Each case was run at the deck's h = 1e-4 s and at h/2 = 5e-5 s (fixed steps come back
@@ -259,7 +259,7 @@ fn read_golden(case: &str) -> Vec<(f64, Vec<Sample>)> {
     let path = golden_path(case);
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
         panic!(
-            "{}: {e}; regenerate with MECANO_REGEN_GOLDEN=1 cargo test --release --test pendulum",
+            "{}: {e}; regenerate with MECANO_REGEN_GOLDEN=1 cargo test --release --test validation pendulum::",
             path.display()
         )
     });

@@ -2,7 +2,7 @@
 //! results as the material and geometry they equal, a rotary inertia no material can give,
 //! the canonical writer, and bad input.
 
-mod common;
+use crate::common;
 
 use mecano::app::modes::{About, analyse_model};
 use mecano::deck::{load_deck, parse_deck, strip_spans, write_deck};

@@ -1,7 +1,7 @@
 //! The 45° bend (Bathe & Bolourchi 1979) solved without finite elements: the static
 //! equilibrium of the Reissner–Simo rod as a boundary-value problem, integrated along the
 //! arc (RK4) and shot from the clamp. An independent route to the converged answer that the
-//! beam elements are checked against (`tests/high_order.rs`, `beam_p_cases.rs`).
+//! beam elements are checked against (`tests/validation/high_order.rs`, `beam_p_cases.rs`).
 //!
 //! Equations (Simo 1985, eqs. 2.10–2.14; Simo & Vu-Quoc 1986 §2, statics): with the triad
 //! `Λ(s)`, the material strains `Γ = Λᵀx′ − e₁`, `K = axial(ΛᵀΛ′) − K⁰` and the spatial

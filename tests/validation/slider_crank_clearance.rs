@@ -5,7 +5,7 @@
 //! of the rigid mechanism (ideal twin) and bounds derived from it and from the contact law
 //! (clearance deck).
 
-mod common;
+use crate::common;
 
 use common::deck;
 use mecano::model::{Adaptive, Analysis, ElementKind, Model, NodeId};

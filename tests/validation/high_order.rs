@@ -4,7 +4,7 @@
 //! Timoshenko frequencies — are unit tests in `src/elements/beam_p_tests.rs` and
 //! `beam_p_cases.rs`.)
 
-mod common;
+use crate::common;
 
 use common::deck;
 use mecano::deck::{parse_deck, write_deck};
@@ -127,7 +127,7 @@ fn bad_order_and_arc_are_reported() {
 /// The free-flying beam (`flying_beam.dat`, after Simo & Vu-Quoc 1988) as ONE element of
 /// order p: after the pulse nothing acts on it, so its energy must stay constant; the
 /// Lie-group trapezoidal rule (α = 0) keeps it bounded with an error of second order in h,
-/// as for the two-node beam (tests/dynamics.rs): drift over 5 s of free flight below 1e-3
+/// as for the two-node beam (tests/mechanics/dynamics.rs): drift over 5 s of free flight below 1e-3
 /// (the two-node mesh measures 5e-5) and divided by at least 2.5 when h is halved.
 /// (At α = 0 the step must resolve the element's highest frequency, which grows as p² for
 /// a spectral element: one element of order 8 blows up at h = 0.01 — the known nonlinear

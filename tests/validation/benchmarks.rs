@@ -220,7 +220,6 @@ fn right_angle_cantilever_energy_after_the_load() {
 
 // ---------------------------------------------------------------- flexible slider-crank
 
-#[path = "benchmarks/slider_crank.rs"]
 mod slider_crank;
 
 /// The rod's mid-span deflection relative to its chord, over the rod's length (nodes 10,
@@ -374,7 +373,5 @@ fn flexible_slider_crank_mid_span_deflection_follows_the_modal_route() {
 
 // ---------------------------------------------------------------- spatial four-bar
 
-#[path = "benchmarks/four_bar.rs"]
 mod four_bar;
-#[path = "benchmarks/four_bar_runs.rs"]
 mod four_bar_runs;

@@ -4,7 +4,7 @@
 //! joints and contacts stay where the user put them, and a refined deck is the same model
 //! — and gives the same motion — as the hand-written finer deck.
 
-mod common;
+use crate::common;
 
 use mecano::deck::{load_deck, parse_deck, strip_spans, write_deck};
 use mecano::model::{ElementId, ElementKind, Model, NodeId};
