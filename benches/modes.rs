@@ -16,7 +16,7 @@
 //! the checks. `large/factor_200_solves` is the reference: the same matrix factored with
 //! pivoting and 200 solves. Each iteration starts from a freshly prepared system (its
 //! preparation is not timed), so both make a first, pivoting factorisation. The
-//! frequencies are not checked here (tests/modes_sparse.rs does against the dense path).
+//! frequencies are not checked here (tests/mechanics/modes_sparse.rs does against the dense path).
 
 use criterion::{BatchSize, Criterion, criterion_group};
 use mecano::modes::{Solver, analyse};

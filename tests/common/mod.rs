@@ -1,9 +1,11 @@
-//! Helpers shared by the integration tests (`mod common;` in each test file): the repository's
+//! Helpers shared by the integration tests (`mod common;` in each test file's root; the groups
+//! `tests/<group>/main.rs` declare it once with `#[path = "../common/mod.rs"]`, and their
+//! modules `use crate::common;`): the repository's
 //! paths, its decks, and scratch directories that are removed when the test ends, whether it
 //! passed, failed or panicked (issue 27 §3: no `mecano_*` directory left in the system's
 //! temporary folder after a CI run).
 //!
-//! Each test file compiles this module on its own, and uses only part of it.
+//! Each test binary compiles this module on its own, and uses only part of it.
 #![allow(dead_code)]
 
 pub mod impact;
