@@ -5,7 +5,7 @@
 #
 #   benches/esdirk_ratio.sh [OUT] [ROUNDS] [ESDIRK_STEP] [EVERY] [SCHEME]
 #
-# SCHEME is the ANALYSIS keyword of the stage scheme: ESDIRK3 (default), ESDIRK4 or ESDIRK5.
+# SCHEME is the ANALYSIS keyword of the stage scheme: ESDIRK3 (default) or ESDIRK5.
 # OUT (default out/esdirk) keeps the decks and runs; the reference (two elements of order 8
 # per bar, HHT at h = 3.90625e-6 s, as benches/order_ratio.sh makes it) is made once and
 # reused. HHT runs at h = 1.5625e-5 s (the step decks/pendulum_converged.dat needs for
