@@ -837,6 +837,19 @@ fn esdirk5_spectral_properties_match_its_order_and_l_stability() {
     let (r3, r6) = (spectral(&e, 1e3).radius, spectral(&e, 1e6).radius);
     assert!((r3 / r6 / 1e3 - 1.0).abs() < 1e-2, "{r3} {r6}");
     assert!(r6 < 1e-4);
+    // Beyond Ω = π the phase of R wraps; the damping is that of the phase followed from
+    // Ω = 0 (review: it read 0, "unresolved", for the modes ESDIRK5 keeps and those it
+    // damps). |R| = exp(−ξ̄ φ) with the phase φ between π and 4π (it rises to ≈ 3.5π), so
+    // ξ̄ lies between −ln|R|/4π and −ln|R|/π; the period is not resolved (Ω ≥ π).
+    for w in [4.0, 8.0, 20.0, 50.0] {
+        let a = spectral(&e, w);
+        let l = -a.radius.ln();
+        assert!(
+            a.damping >= l / (4.0 * PI) && a.damping <= l / PI && a.damping > 0.0,
+            "Ω = {w}: {a:?}"
+        );
+        assert!(a.period_error.is_infinite(), "Ω = {w}: {a:?}");
+    }
 }
 
 /// `--check` on an ESDIRK3 deck compares HHT and generalized-α too and names the highest
