@@ -51,6 +51,14 @@ pub enum SchemeNameError {
         "unknown integrator '{0}' (expected hht[:alpha], genalpha[:rho_inf], esdirk3 or esdirk5)"
     )]
     Unknown(String),
+    /// A parameter after `:` for a scheme that has none (the ESDIRK schemes).
+    #[error("integrator '{name}' takes no parameter (got ':{value}')")]
+    NoParameter {
+        /// The scheme's name.
+        name: &'static str,
+        /// The text after `:`.
+        value: String,
+    },
     /// The parameter after `:` is not a number in the scheme's range.
     #[error("integrator '{name}': the parameter '{value}' is not a number in {range}")]
     Parameter {
@@ -154,8 +162,20 @@ impl Scheme {
                     Some(_) => num("genalpha", "[0, 1]", Scheme::rho_inf_ok)?,
                 },
             }),
-            "esdirk3" if value.is_none() => Ok(Scheme::Esdirk3),
-            "esdirk5" if value.is_none() => Ok(Scheme::Esdirk5),
+            "esdirk3" | "esdirk5" => {
+                let scheme = if name.eq_ignore_ascii_case("esdirk3") {
+                    Scheme::Esdirk3
+                } else {
+                    Scheme::Esdirk5
+                };
+                match value {
+                    None => Ok(scheme),
+                    Some(v) => Err(SchemeNameError::NoParameter {
+                        name: scheme.name(),
+                        value: v.to_string(),
+                    }),
+                }
+            }
             _ => Err(SchemeNameError::Unknown(s.to_string())),
         }
     }
@@ -214,6 +234,10 @@ mod tests {
             Scheme::parse("newmark"),
             Err(SchemeNameError::Unknown(_))
         ));
+        assert_eq!(
+            Scheme::parse("esdirk5:0.3").map_err(|e| e.to_string()),
+            Err("integrator 'esdirk5' takes no parameter (got ':0.3')".to_string())
+        );
         for n in Scheme::NAMES {
             let s = Scheme::parse(n).unwrap();
             assert_eq!(s.name(), *n);

@@ -63,14 +63,16 @@ fn parse_scheme(s: &str) -> Result<Scheme, String> {
 }
 
 impl StudyArgs {
-    /// The schemes asked for: `--alpha`'s as HHT, then `--integrator`'s (empty: the deck's).
+    /// The schemes asked for: `--alpha`'s as HHT, then `--integrator`'s (empty: the deck's),
+    /// each once (a scheme named twice would run its ladder twice and write its rows twice).
     pub fn schemes(&self) -> Vec<Scheme> {
-        let mut v: Vec<Scheme> = self
-            .alpha
-            .iter()
-            .map(|&alpha| Scheme::Hht { alpha })
-            .collect();
-        v.extend(self.integrator.iter().copied());
+        let mut v: Vec<Scheme> = Vec::new();
+        let asked = self.alpha.iter().map(|&alpha| Scheme::Hht { alpha });
+        for s in asked.chain(self.integrator.iter().copied()) {
+            if !v.contains(&s) {
+                v.push(s);
+            }
+        }
         v
     }
 }
