@@ -283,28 +283,8 @@ impl Integrator {
         history: Vec<f64>,
         fref: f64,
     ) -> Result<Vec<f64>, Failure> {
-        let sub = EvalContext { h: ch, ..*ctx };
-        let (mut refuse, mut unresolved) = (None::<f64>, None::<(f64, crate::model::ElementId)>);
-        for e in self.sys.elements.iter() {
-            let Some(lim) = e.step_limit(&sub, &self.nodes, &self.trial) else {
-                continue;
-            };
-            if ch > lim.accept_up_to {
-                refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
-                if lim.unresolved && unresolved.is_none() {
-                    unresolved = Some((lim.retry, e.id()));
-                }
-            }
-        }
-        if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
-            let retry = retry.max(self.event_floor).min(0.999 * h);
-            return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
-        }
-        if let Some((asks, element)) = unresolved {
-            let why = FailureReason::EventUnresolved { element, asks };
-            return Err(self.failure(h, why, history, fref));
-        }
-        Ok(history)
+        self.event_control(h, ch, ctx, history, fref)
+            .map(|(_, history)| history)
     }
 
     /// The trial state of the stage being solved from Newton's increment `u` (module

@@ -348,7 +348,7 @@ impl Integrator {
         ctx: &EvalContext,
         iter: u32,
         rel: f64,
-        history: Vec<f64>,
+        mut history: Vec<f64>,
         fref: f64,
     ) -> Result<StepInfo, Failure> {
         let ctx = *ctx;
@@ -380,33 +380,8 @@ impl Integrator {
         }
         if self.dynamic {
             // Event control before committing: an element may refuse the step.
-            let (old, new) = (&self.nodes, &self.trial);
-            let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
-            let mut unresolved = None::<(f64, crate::model::ElementId)>;
-            for e in self.sys.elements.iter() {
-                let Some(lim) = e.step_limit(&ctx, old, new) else {
-                    continue;
-                };
-                next = next.min(lim.next);
-                if h > lim.accept_up_to {
-                    refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
-                    if lim.unresolved && unresolved.is_none() {
-                        unresolved = Some((lim.retry, e.id()));
-                    }
-                }
-            }
-            if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
-                let retry = retry.max(self.event_floor).min(0.999 * h);
-                return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
-            }
-            // At the smallest step the run allows a refusal cannot be honoured. One that
-            // only lands an event more precisely is waived (the event is timed within this
-            // step); one that cannot resolve the event at all would integrate an impact in
-            // too few steps, which can create energy no work paid for: stop, diagnosed.
-            if let Some((asks, element)) = unresolved {
-                let why = FailureReason::EventUnresolved { element, asks };
-                return Err(self.failure(h, why, history, fref));
-            }
+            let (next, kept) = self.event_control(h, h, &ctx, history, fref)?;
+            history = kept;
             self.step_cap = next;
         }
         self.accept(h, &ctx);
@@ -416,6 +391,48 @@ impl Integrator {
             iterations: iter,
             residual: rel,
         })
+    }
+
+    /// The elements' event control (a contact's touch, release, impact resolution:
+    /// `Element::step_limit`) from the accepted state to the trial one, over `len` (the
+    /// step's length `h`, or an inner stage's `c_i h`). A refusal refuses the step, to retry
+    /// at the length asked; at the smallest step a landing refusal is waived (the event is
+    /// timed within the step) and one that cannot resolve the event at all stops the run,
+    /// diagnosed (it would integrate an impact in too few steps, which can create energy
+    /// no work paid for). Returns the cap of the next step and the Newton history.
+    pub(super) fn event_control(
+        &mut self,
+        h: f64,
+        len: f64,
+        ctx: &EvalContext,
+        history: Vec<f64>,
+        fref: f64,
+    ) -> Result<(f64, Vec<f64>), Failure> {
+        let sub = EvalContext { h: len, ..*ctx };
+        let (old, new) = (&self.nodes, &self.trial);
+        let (mut next, mut refuse) = (f64::INFINITY, None::<f64>);
+        let mut unresolved = None::<(f64, crate::model::ElementId)>;
+        for e in self.sys.elements.iter() {
+            let Some(lim) = e.step_limit(&sub, old, new) else {
+                continue;
+            };
+            next = next.min(lim.next);
+            if len > lim.accept_up_to {
+                refuse = Some(refuse.map_or(lim.retry, |r| r.min(lim.retry)));
+                if lim.unresolved && unresolved.is_none() {
+                    unresolved = Some((lim.retry, e.id()));
+                }
+            }
+        }
+        if let Some(retry) = refuse.filter(|_| h > self.event_floor * (1.0 + 1e-9)) {
+            let retry = retry.max(self.event_floor).min(0.999 * h);
+            return Err(self.failure(h, FailureReason::StepRefused(retry), history, fref));
+        }
+        if let Some((asks, element)) = unresolved {
+            let why = FailureReason::EventUnresolved { element, asks };
+            return Err(self.failure(h, why, history, fref));
+        }
+        Ok((next, history))
     }
 }
 
