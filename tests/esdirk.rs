@@ -568,7 +568,7 @@ fn esdirk5_restitution_is_accurate_through_the_unclipped_contact() {
 }
 
 /// A stage scheme's steps are checked for events at every stage, not only at their ends
-/// (`stage_events` in src/solver/integrator/esdirk.rs): the steel clearance impact of
+/// (`Integrator::event_control` at each inner stage, src/solver/integrator/esdirk.rs): the steel clearance impact of
 /// `stab_clearance_impact.dat` (5 m/s into a 0.5 mm clearance, the Lankarani–Nikravesh law
 /// with k = 6.61e10, e = 0.9: an impact 1e-5 s long at t = 1e-4 s) with base steps 1e-3,
 /// 5e-4 and 1e-4 s. With the ends alone a 5e-4 s step's stages sat in the contact that both

@@ -56,11 +56,6 @@ pub fn tableau_of(scheme: &Scheme) -> Option<&'static Tableau> {
     }
 }
 
-/// ESDIRK3's stability function ([`Tableau::stability`]).
-pub fn stability(z: nalgebra::Complex<f64>) -> nalgebra::Complex<f64> {
-    ESDIRK3.stability(z)
-}
-
 /// Most stages.
 const S: usize = MAX_STAGES;
 
@@ -86,7 +81,9 @@ pub struct Stages {
     /// docs: the inner stages), with their rows `s γh B(q_i) v_i` in `rows`.
     velocity_level: bool,
     rows: Vec<f64>,
-    /// The central difference's `ε` of the stage being solved (NaN: not chosen yet).
+    /// The central difference's `ε` of the stage being solved, chosen at its first
+    /// iteration and kept, so that the rows are one function of Newton's iterate within a
+    /// stage (NaN: not chosen yet).
     eps: f64,
     /// The nodes of the elements with multipliers (the joints), each once.
     joint_nodes: Vec<usize>,
@@ -184,11 +181,6 @@ impl Integrator {
         self.esdirk.is_some()
     }
 
-    /// The ESDIRK scheme's tableau, `None` for the α family.
-    pub fn esdirk_tableau(&self) -> Option<&'static Tableau> {
-        self.esdirk.as_deref().map(|st| st.tab)
-    }
-
     /// One ESDIRK step of size `h` (module docs): the implicit stages by Newton,
     /// then the checks of a converged step and the acceptance of the last stage. On
     /// failure the accepted state is unchanged.
@@ -252,7 +244,13 @@ impl Integrator {
                 info.iterations += before;
                 return Ok(info);
             }
-            let history = self.stage_events(h, ci * h, &ctx, history, fref)?;
+            // Event control over [t, t + c_i h], from the step's start to the stage: a stage
+            // may sit deep in a contact that both ends of the step are clear of (a step of
+            // 1e-3 s over the steel clearance impact of `decks/stab_clearance_impact.dat`,
+            // 1e-4 s long, ended with 0.3 J of 5.0 with ESDIRK3 and created 33 J with
+            // ESDIRK5, and neither end saw it). A refusal refuses the whole step, to retry at
+            // the length asked (measured from the step's start, as at the end).
+            let (_, history) = self.event_control(h, ci * h, &ctx, history, fref)?;
             self.history = history;
             before += iter;
             let st = self.esdirk.as_deref_mut().expect("ESDIRK stages");
@@ -263,28 +261,6 @@ impl Integrator {
             }
         }
         unreachable!("the last stage returns")
-    }
-
-    /// Event control of an inner stage: the elements' step limits (a contact's touch,
-    /// release and impact resolution, `Element::step_limit`) from the step's start to the
-    /// stage's state, over `[t, t + c_i h]` (`ch = c_i h`). The step's end alone is not
-    /// enough for a stage scheme: a stage may sit deep in a contact that both ends of the
-    /// step are clear of (a step of 1e-3 s over the steel clearance impact of
-    /// `decks/stab_clearance_impact.dat`, 1e-4 s long, ended with 0.3 J of kinetic energy
-    /// out of 5.0 with ESDIRK3 and created 33 J with ESDIRK5, and neither end saw it). A
-    /// refusal here refuses the whole step, to retry at the length the element asks for
-    /// (measured from the step's start, as at the end); at the smallest step a landing
-    /// refusal is waived and an unresolved one stops the run, as in `finish_step`.
-    fn stage_events(
-        &mut self,
-        h: f64,
-        ch: f64,
-        ctx: &EvalContext,
-        history: Vec<f64>,
-        fref: f64,
-    ) -> Result<Vec<f64>, Failure> {
-        self.event_control(h, ch, ctx, history, fref)
-            .map(|(_, history)| history)
     }
 
     /// The trial state of the stage being solved from Newton's increment `u` (module
@@ -330,7 +306,7 @@ impl Integrator {
         st.rows.clear();
         st.rows.resize(n - nn, 0.0);
         // `B v`: the nodes moved along their velocities by ±ε at the stage's time, ε|v| =
-        // 1e-4 L_ref. A driver's `∂Φ/∂t`: a second difference in time alone, over
+        // 1e-4 L_ref. A driver's `∂Φ/∂t`: a central difference in time alone, over
         // ±ε_t = ±1e-2 γh, so that it reads the driver's law where the stage is (moving
         // time with the state by ε, as until this session, read a HAVERSINE law up to
         // seconds past its end near rest, where it is flat: driven_arm.dat's velocities were
