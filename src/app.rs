@@ -191,7 +191,7 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
         }
     }
     match solver::prepare(&model) {
-        Ok(integ) => {
+        Ok(mut integ) => {
             let _ = writeln!(
                 out,
                 "equations:   {} ({} nodal, {} multipliers; {} non-zeros in the iteration matrix)",
@@ -200,15 +200,57 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
                 integ.sys.n_eq() - integ.sys.n_node_eq,
                 integ.sys.matrix.nnz()
             );
+            // What the solver will change before the first step: held rotations,
+            // redundant equations removed, the assembly of the initial positions.
+            let started = if integ.sys.n_eq() > integ.sys.n_node_eq {
+                integ.start_constraints()
+            } else {
+                Ok(())
+            };
+            for n in &integ.notices {
+                let _ = writeln!(out, "note:        {n}");
+            }
+            if let Err(f) = started {
+                let _ = writeln!(out, "start:       the run will stop at t = 0: {f}");
+            }
             check_output(&mut out, path, &model, &integ.sys);
             // The mesh's highest frequency and what the step resolves (issue 24).
             modes::check_report(&model, &mut out);
             EXIT_OK
         }
         Err(e) => {
-            eprintln!("error: {}: {e}", path.display());
+            eprintln!("error: {}", located_build_error(path, &e));
             EXIT_BAD_INPUT
         }
+    }
+}
+
+/// `file:line:col` of a byte offset of the deck at `path` (its text read again), or the
+/// path alone when the offset is not in it.
+pub fn locate(path: &Path, offset: usize) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    if offset > text.len() || !text.is_char_boundary(offset) {
+        return path.display().to_string();
+    }
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let col = before[before.rfind('\n').map_or(0, |p| p + 1)..]
+        .chars()
+        .count()
+        + 1;
+    format!("{}:{line}:{col}", path.display())
+}
+
+/// A build error of the solver with its place in the deck where it has one (nodes whose
+/// motion is undetermined point at their NODES card).
+pub fn located_build_error(path: &Path, e: &solver::BuildError) -> String {
+    match e {
+        solver::BuildError::Undetermined(nodes) => nodes
+            .iter()
+            .map(|n| format!("{}: {n}", locate(path, n.span.start)))
+            .collect::<Vec<_>>()
+            .join("\nerror: "),
+        other => format!("{}: {other}", path.display()),
     }
 }
 
@@ -347,7 +389,15 @@ fn start_session(
     every_step: bool,
     force: bool,
 ) -> Result<RunReport, (u8, String)> {
-    let integ = solver::prepare(model).map_err(|e| (EXIT_BAD_INPUT, e.to_string()))?;
+    let integ = solver::prepare(model).map_err(|e| {
+        // The caller prefixes the deck's name: the place follows as line and column.
+        let text = located_build_error(Path::new(deck_name), &e);
+        let text = text
+            .strip_prefix(deck_name)
+            .and_then(|t| t.strip_prefix(':'))
+            .map_or(text.clone(), |t| format!("line {}", t.trim_start()));
+        (EXIT_BAD_INPUT, text)
+    })?;
     let files = outdir::run_files(
         crate::output::history_files(model, &integ.sys),
         model.output.vtk,
@@ -491,11 +541,7 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
     // `ANALYSIS MODES n`: the modal analysis of `mecano-rs modes DECK --count n` about the
     // initial state, written into the run's directory (no time run, no checkpoint).
     if let Some(n) = model.modes {
-        let about = if model.modes_rotating {
-            modes::About::Rotating
-        } else {
-            modes::About::Initial
-        };
+        let about = crate::modes::about::deck_about(&model);
         return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
     }
     let what = path.display().to_string();

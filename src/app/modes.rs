@@ -231,6 +231,12 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
     match lowest_about_initial(model, 5, true) {
         Ok(a) => {
             let _ = writeln!(out, "modes about the initial state (mecano-rs modes):");
+            if let Some(w) = reach_state(model, About::Initial)
+                .ok()
+                .and_then(|i| crate::modes::about::equilibrium_warning(&i))
+            {
+                let _ = writeln!(out, "  warning: {w}");
+            }
             print_table(out, &a, deck_step(model));
             if let Some(st) = deck_step(model) {
                 print_integrators(out, &a, st);
@@ -302,7 +308,7 @@ pub fn run(args: &ModesArgs) -> u8 {
         _ if args.rotating || model.modes_rotating => About::Rotating,
         (true, _) => About::Static,
         (false, Some(t)) => About::At(t),
-        (false, None) => About::Initial,
+        (false, None) => crate::modes::about::deck_about(&model),
     };
     let count = args.count.or(model.modes).map_or(10, |c| c as usize);
     let dir = out_dir(args, &model);
@@ -357,6 +363,15 @@ fn run_loaded_using(
             };
         }
     };
+    for n in &integ.notices {
+        eprintln!("warning: {}: {n}", deck.display());
+    }
+    let not_equilibrium = (about != About::Rotating)
+        .then(|| crate::modes::about::equilibrium_warning(&integ))
+        .flatten();
+    if let Some(w) = &not_equilibrium {
+        eprintln!("warning: {}: {w}", deck.display());
+    }
     let state = match about {
         About::Initial => "initial".to_string(),
         About::Static => "static equilibrium".to_string(),
@@ -366,6 +381,12 @@ fn run_loaded_using(
     let step = deck_step(model);
     let mut summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
     summary["vtk"] = modes_vtk::summary(&integ.sys, &a);
+    if let Some(w) = not_equilibrium {
+        summary["warnings"] = serde_json::json!([w]);
+    }
+    if !integ.notices.is_empty() {
+        summary["notices"] = serde_json::to_value(&integ.notices).unwrap_or_default();
+    }
     if about == About::Rotating
         && let Ok(f) = Frame::from_model(model, integ.t)
     {

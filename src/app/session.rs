@@ -99,6 +99,16 @@ impl Controlled<'_> {
 
 impl Observer for Controlled<'_> {
     fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
+        if snap.step == 0 {
+            // What the solver changed before the first step (held rotations, removed
+            // redundant equations, assembly, projected velocities): said once, at the
+            // start, and kept in summary.json.
+            for n in &snap.integ.notices {
+                eprintln!("warning: {n}");
+            }
+            notices_into(self.writer, snap.integ);
+            self.writer.write_notes()?;
+        }
         self.writer.state(snap)?;
         if let Some(v) = self.vtk.as_deref_mut() {
             v.state(snap)?;
@@ -220,9 +230,10 @@ impl Session<'_> {
                     failure: Some(solver::Failure {
                         time: integ.t,
                         step: 0.0,
+                        load_steps: !integ.dynamic,
                         reason: solver::FailureReason::NotFinite,
                         residual_history: vec![],
-                        worst: format!("output: {e}"),
+                        worst: format!("output: {e}").into(),
                         worst_value: 0.0,
                         reference_force: 0.0,
                         diagnoses: Box::default(),
@@ -233,6 +244,7 @@ impl Session<'_> {
             Err(e) => return Err((EXIT_BAD_INPUT, e.to_string())),
         };
         report.stats = integ.stats;
+        notices_into(&mut self.writer, integ);
         if report.interrupted.is_some() {
             let signal = self.interrupts.signal_name().unwrap_or("a stop request");
             self.writer
@@ -254,5 +266,15 @@ impl Session<'_> {
             }
         }
         Ok(report)
+    }
+}
+
+/// The integrator's notices into the summary's `"notices"` (none: no entry).
+fn notices_into(writer: &mut Writer, integ: &Integrator) {
+    if !integ.notices.is_empty() {
+        writer.notes.insert(
+            "notices".into(),
+            serde_json::to_value(&integ.notices).unwrap_or_default(),
+        );
     }
 }

@@ -547,6 +547,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ANALYSIS",
         "number of static load steps (>= 1, default 1)",
     ),
+    kw(
+        "PROPORTIONAL",
+        "ANALYSIS",
+        "STATIC: gravity and the loads without a function grow with the load factor",
+    ),
     // output
     kw("NONE", "OUTPUT", "no entity"),
     kw(

@@ -376,10 +376,17 @@ pub fn write_deck(model: &Model) -> String {
         // `ANALYSIS MODES n` parses to the default static analysis of one step: the card
         // alone gives the model back.
         (_, Some(n)) => {
-            let rot = if model.modes_rotating {
-                " ROTATING"
-            } else {
-                ""
+            let rot = match &model.analysis {
+                _ if model.modes_rotating => " ROTATING".to_string(),
+                Analysis::Static {
+                    steps,
+                    proportional,
+                    ..
+                } if model.modes_static => {
+                    let p = if *proportional { " PROPORTIONAL" } else { "" };
+                    format!(" STATIC STEPS {steps}{p}")
+                }
+                _ => String::new(),
             };
             let _ = writeln!(s, "ANALYSIS MODES {n}{rot}");
         }
@@ -426,10 +433,18 @@ pub fn write_deck(model: &Model) -> String {
                 newton_kind(newton)
             );
         }
-        (Analysis::Static { steps, newton }, None) => {
+        (
+            Analysis::Static {
+                steps,
+                newton,
+                proportional,
+            },
+            None,
+        ) => {
+            let p = if *proportional { " PROPORTIONAL" } else { "" };
             let _ = writeln!(
                 s,
-                "ANALYSIS STATIC STEPS {steps} TOL {:?} TOLINC {:?} MAXIT {} NEWTON {}",
+                "ANALYSIS STATIC STEPS {steps}{p} TOL {:?} TOLINC {:?} MAXIT {} NEWTON {}",
                 newton.tol_residual,
                 newton.tol_increment,
                 newton.max_iterations,

@@ -474,6 +474,17 @@ pub trait Element: Send + Sync {
         }
     }
 
+    /// Whether the element acts on the rotation of its `k`-th node (in
+    /// [`Element::nodes`]) at any time of a run: a node whose rotations no element acts on
+    /// (a point mass alone, a bouncing ball) has them held by the solver, which would
+    /// otherwise face a singular matrix ([`crate::solver::idle`]). The default,
+    /// [`RotationUse::AsEvaluated`], reads it from the element's iteration matrix at the
+    /// initial state, right for every element whose coupling does not switch on later;
+    /// elements whose forces appear only at events (contacts) say it themselves.
+    fn rotation_use(&self, _k: usize) -> RotationUse {
+        RotationUse::AsEvaluated
+    }
+
     /// Event (impact) control of a converged trial step from `old` to `new` (step
     /// `ctx.h`), asked before the step is committed. `None` = no opinion (the default).
     /// The integrator refuses the step when `ctx.h > accept_up_to` (and retries with
@@ -486,6 +497,19 @@ pub trait Element: Send + Sync {
     ) -> Option<StepLimit> {
         None
     }
+}
+
+/// How an element acts on one of its nodes' rotations over a run
+/// ([`Element::rotation_use`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotationUse {
+    /// As its iteration matrix (stiffness, damping, mass, constraint rows) at the initial
+    /// state shows: an all-zero rotational column means never.
+    AsEvaluated,
+    /// It may act on them (a contact's moment), whatever the initial state shows.
+    Always,
+    /// It never does.
+    Never,
 }
 
 /// An element's verdict on a converged step (see [`Element::step_limit`]).

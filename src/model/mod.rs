@@ -362,6 +362,10 @@ pub enum Analysis {
         steps: u32,
         /// Newton settings.
         newton: NewtonSettings,
+        /// `PROPORTIONAL`: gravity and the loads without a function grow in proportion to
+        /// the load factor (else they are applied whole from the first step, and only the
+        /// loads' functions of the load factor change from step to step).
+        proportional: bool,
     },
 }
 
@@ -427,6 +431,10 @@ pub struct Model {
     /// hub driven at constant speed, seen in the rotating frame (as `mecano-rs modes
     /// --rotating`; [`crate::modes::rotating`]).
     pub modes_rotating: bool,
+    /// `ANALYSIS MODES n STATIC [STEPS k]`: the modes about the static equilibrium under
+    /// the deck's loads, reached in `k` load steps (`analysis` is that static analysis),
+    /// as `mecano-rs modes --static`.
+    pub modes_static: bool,
     /// Output requests.
     pub output: OutputRequest,
     /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the

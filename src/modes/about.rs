@@ -22,6 +22,18 @@ pub enum About {
     Rotating,
 }
 
+/// Where an `ANALYSIS MODES` deck asks its modes to be taken: `ROTATING`, `STATIC`, or
+/// the initial state.
+pub fn deck_about(model: &Model) -> About {
+    if model.modes_rotating {
+        About::Rotating
+    } else if model.modes_static {
+        About::Static
+    } else {
+        About::Initial
+    }
+}
+
 /// A failure to reach the state or to solve: bad input (the command exits 2) or a failed
 /// solve or run (1).
 #[derive(Debug)]
@@ -83,7 +95,17 @@ fn reach_state_with(model: &Model, about: About, warn: bool) -> Result<Integrato
             .map_err(|e| failed(format!("the rotating state: {e}")))?;
             return Ok(integ);
         }
-        About::Static => m.analysis = Analysis::Static { steps: 1, newton },
+        // The deck's own load steps when it is a static analysis (`ANALYSIS STATIC STEPS
+        // k`, `ANALYSIS MODES n STATIC STEPS k`), else one, cut automatically.
+        About::Static => {
+            if !matches!(m.analysis, Analysis::Static { .. }) {
+                m.analysis = Analysis::Static {
+                    steps: 1,
+                    newton,
+                    proportional: false,
+                }
+            }
+        }
         About::At(t) => match &mut m.analysis {
             Analysis::Dynamic { end, .. } => {
                 if !(t >= 0.0 && t <= *end) {
@@ -101,6 +123,11 @@ fn reach_state_with(model: &Model, about: About, warn: bool) -> Result<Integrato
     }
     let mut integ = solver::prepare(&m).map_err(|e| bad(e.to_string()))?;
     if about == About::Initial {
+        // The initial state is the dynamic one whatever the deck runs (an `ANALYSIS
+        // MODES` deck is static): consistent accelerations and multipliers, so that the
+        // constraints' forces (a pendulum's tension under gravity) give their geometric
+        // stiffness, as `mecano-rs modes` of the same model in a dynamic deck does.
+        integ.dynamic = true;
         if let Err(f) = integ.initialize() {
             // An over-constrained mechanism (the four-bar of hinges) has no unique
             // multipliers, and runs refuse it; its modes are still defined: linearise
@@ -225,4 +252,40 @@ pub fn lowest_about_initial(
         .min(probe.finite_modes)
         .min(probe.free_unknowns);
     Ok(analyse_model_with(model, About::Initial, n, warn, Solver::Dense)?.1)
+}
+
+/// How far the state a modal analysis linearises about is from a static equilibrium:
+/// the largest nodal acceleration (`|ẍ|`, and `|ω̇| L` for rotations, `L` the model's
+/// reference length), m/s², and whether the state moves (kinetic energy). Modes about a
+/// state that accelerates or moves are those of the linearised equations there, not free
+/// vibrations about an equilibrium.
+pub fn equilibrium_gap(integ: &Integrator) -> (f64, bool) {
+    let l = integ.sys.ref_length;
+    let acc = integ
+        .nodes
+        .iter()
+        .fold(0.0f64, |m, s| m.max(s.a.norm()).max(s.wd.norm() * l));
+    let moving = integ.energies().kinetic > 0.0;
+    (acc, moving)
+}
+
+/// The warning [`equilibrium_gap`] calls for, if any: accelerations above `1e-6` of the
+/// reference acceleration (gravity's, or 1 m/s² without gravity), or a moving state.
+pub fn equilibrium_warning(integ: &Integrator) -> Option<String> {
+    let (acc, moving) = equilibrium_gap(integ);
+    let g = integ.sys.gravity.norm();
+    let a_ref = if g > 0.0 { g } else { 1.0 };
+    let mut why = Vec::new();
+    if acc > 1e-6 * a_ref {
+        why.push(format!("accelerates (up to {acc:.3e} m/s²)"));
+    }
+    if moving {
+        why.push("moves (its kinetic energy is not zero)".to_string());
+    }
+    (!why.is_empty()).then(|| {
+        format!(
+            "the state linearised about is not a static equilibrium: it {}; the modes are those of the equations linearised there, not free vibrations (for those, take the modes about the static equilibrium: --static)",
+            why.join(" and ")
+        )
+    })
 }

@@ -334,9 +334,12 @@ impl Writer {
             st.row(&node_row(integ, *i))?;
         }
         let ctx = integ.current_context();
+        // Where redundant equations were removed the reactions are not unique: the
+        // minimum-norm ones are written (solver::redundancy).
+        let reported = integ.reported_multipliers();
         let element_row = |e: usize, row: &mut Vec<f64>| {
             let el = &integ.sys.elements[e];
-            let lam = integ.sys.element_lambda(e, &integ.lambda);
+            let lam = integ.sys.element_lambda(e, &reported);
             row.clear();
             row.push(t);
             el.write_output_row(&ctx, &integ.nodes, lam, row);
@@ -531,7 +534,7 @@ fn failure_json(f: &Failure) -> serde_json::Value {
         "time": f.time,
         "step": f.step,
         "residual_history": f.residual_history.iter().map(|r| if r.is_finite() { *r } else { f64::MAX }).collect::<Vec<_>>(),
-        "worst": f.worst,
+        "worst": &*f.worst,
         "worst_value": if f.worst_value.is_finite() { f.worst_value } else { f64::MAX },
     })
 }

@@ -187,6 +187,14 @@ pub struct Integrator {
     /// Buffers of [`Integrator::consistent_accelerations`], kept so that the restarts of
     /// the accelerations at a contact's events allocate nothing (issue 27 §1d).
     acc: AccelerationScratch,
+    /// The constraint equations removed as redundant at the start, and the groups where
+    /// the reported reactions are made minimum-norm ([`crate::solver::redundancy`]).
+    pub redundancy: crate::solver::redundancy::Redundancy,
+    /// What the solver changed of the model or its initial state before the first step
+    /// (held rotations, removed equations, assembly, projected velocities).
+    pub notices: Vec<crate::solver::notice::Notice>,
+    /// [`Integrator::initialize`] ran (a restored state needs the start's structure).
+    pub(crate) started: bool,
 }
 
 /// Work vectors of the consistent-acceleration solve: sized with the integrator, reused.
@@ -275,6 +283,9 @@ impl Integrator {
             error_next: f64::INFINITY,
             event_floor: 0.0,
             abort: None,
+            redundancy: Default::default(),
+            notices: Vec::new(),
+            started: false,
             sys,
         }
     }
@@ -308,7 +319,12 @@ impl Integrator {
             c_v,
             c_a,
             dynamic: self.dynamic,
-            gravity: self.sys.gravity,
+            // `ANALYSIS STATIC … PROPORTIONAL`: gravity by the load factor ([`statics`]).
+            gravity: if !self.dynamic && self.sys.proportional {
+                self.sys.gravity * t.clamp(0.0, 1.0)
+            } else {
+                self.sys.gravity
+            },
             constraint_scale: scale,
             penalty: 0.0,
             h,
@@ -346,6 +362,50 @@ impl Integrator {
     /// (for benchmarks and tools that assemble outside [`Self::try_step`]).
     pub fn step_context(&self, h: f64) -> EvalContext {
         self.context(self.t + h, h, self.scale)
+    }
+
+    /// The multipliers to report at the current state: the run's, but where redundant
+    /// equations were removed the minimum-norm ones that carry the same loads
+    /// ([`crate::solver::redundancy::Redundancy::reported_multipliers`]; a copy only then).
+    pub fn reported_multipliers(&self) -> std::borrow::Cow<'_, [f64]> {
+        if self.redundancy.is_empty() {
+            std::borrow::Cow::Borrowed(&self.lambda)
+        } else {
+            std::borrow::Cow::Owned(self.redundancy.reported_multipliers(
+                &self.sys,
+                &self.nodes,
+                self.t,
+                &self.lambda,
+            ))
+        }
+    }
+
+    /// The largest violation of an equation removed as redundant at the start, if it
+    /// exceeds what the kept equations' tolerance explains: the redundancy was one of the
+    /// initial position only (the mechanism reached a position where the removed equation
+    /// no longer follows from the others), or the equations contradict each other. A
+    /// failure diagnosis then.
+    pub fn check_removed_equations(&self) -> Result<(), Failure> {
+        let Some((v, r)) = self
+            .redundancy
+            .removed_violation(&self.sys, &self.nodes, self.t)
+        else {
+            return Ok(());
+        };
+        if v <= start::removed_tolerance(self.sys.ref_length) {
+            return Ok(());
+        }
+        Err(self.failure(
+            0.0,
+            FailureReason::Constraints(format!(
+                "element {}'s equation {} ({}), removed at the start as redundant, is violated by {v:.3e}: it no longer follows from the other constraints (the redundancy held at the initial position only, or the constraints contradict each other, e.g. two drivers of one motion); model the joint so that it blocks only the motions the others leave free",
+                r.id.0,
+                r.equation + 1,
+                r.motion
+            ).into()),
+            vec![],
+            self.sys.ref_force,
+        ))
     }
 
     /// Largest constraint violation over all elements at the current state.
@@ -390,3 +450,4 @@ pub mod esdirk;
 mod hht;
 mod newton;
 mod start;
+mod statics;

@@ -4,9 +4,12 @@
 //! [`Observer`] (the output writers), so a run that stops early has already delivered
 //! what it computed.
 
+pub mod assembly;
 pub mod energy_guard;
+pub mod idle;
 pub mod integrator;
 pub mod linear;
+pub mod notice;
 pub mod redundancy;
 pub mod state;
 pub mod system;
@@ -72,21 +75,29 @@ pub enum FailureReason {
     /// The run was asked to stop at once ([`Integrator::abort`], e.g. a second Ctrl-C):
     /// not a failure of the step, which was given up.
     Aborted,
+    /// The constraints cannot be met: the initial positions cannot be assembled onto
+    /// them ([`assembly`]), or equations removed as redundant contradict the others or
+    /// stopped following from them ([`redundancy`]).
+    Constraints(Box<str>),
+    /// A static load step found no equilibrium: the loads are not carried.
+    NoEquilibrium(Box<str>),
 }
 
 /// The diagnosis of a failed run: where, when and how badly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Failure {
-    /// Time of the last accepted state, s.
+    /// Time of the last accepted state, s (statics: the load factor).
     pub time: f64,
-    /// Step size of the failed attempt, s.
+    /// Step size of the failed attempt, s (statics: the load step).
     pub step: f64,
+    /// A static analysis: `time` and `step` are a load factor and a load step.
+    pub load_steps: bool,
     /// What went wrong.
     pub reason: FailureReason,
     /// Relative residual at each Newton iteration of the last attempt.
     pub residual_history: Vec<f64>,
     /// The equation with the largest residual, e.g. `node 23 uy`.
-    pub worst: String,
+    pub worst: Box<str>,
     /// Its residual, N or N·m.
     pub worst_value: f64,
     /// Reference force used to scale the residual.
@@ -109,6 +120,7 @@ impl std::fmt::Display for Failure {
                 format!("an element refused the step (asks for h <= {h:.3e} s)")
             }
             FailureReason::Aborted => "the run was aborted".to_string(),
+            FailureReason::Constraints(s) | FailureReason::NoEquilibrium(s) => s.to_string(),
             FailureReason::EventUnresolved { element, asks } => format!(
                 "element {} needs steps of at most {asks:.3e} s to resolve its event (an impact), but the step may not be cut below MINSTEP = {:.3e} s; lower MINSTEP on the ANALYSIS card",
                 element.0, self.step
@@ -118,11 +130,19 @@ impl std::fmt::Display for Failure {
                 j.created, j.before, j.after, j.work
             ),
         };
-        writeln!(
-            f,
-            "{why} at t = {:.6e} s with step h = {:.3e} s",
-            self.time, self.step
-        )?;
+        if self.load_steps {
+            writeln!(
+                f,
+                "{why} at load factor {:.6e} with load step {:.3e}",
+                self.time, self.step
+            )?;
+        } else {
+            writeln!(
+                f,
+                "{why} at t = {:.6e} s with step h = {:.3e} s",
+                self.time, self.step
+            )?;
+        }
         let hist: Vec<String> = self
             .residual_history
             .iter()
@@ -225,8 +245,24 @@ pub enum RunError {
 }
 
 /// Builds the integrator for a model (initial velocities applied, not yet initialised).
+/// Free translations nothing acts on are refused ([`BuildError::Undetermined`]); nodes
+/// whose rotations nothing acts on have them held ([`idle`]), which the integrator's
+/// [`Integrator::notices`] say.
 pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     let sys = System::new(model)?;
+    let idle = idle::scan(&sys, model);
+    if !idle.undetermined.is_empty() {
+        return Err(BuildError::Undetermined(idle.undetermined));
+    }
+    let mut notices = Vec::new();
+    let sys = if idle.rotations.is_empty() {
+        sys
+    } else {
+        notices.push(notice::Notice::HeldRotations {
+            nodes: idle.rotations.iter().map(|&i| sys.node_ids[i]).collect(),
+        });
+        System::new(&idle::with_held_rotations(model, &idle.rotations))?
+    };
     let mut integ = match &model.analysis {
         Analysis::Dynamic { scheme, newton, .. } => {
             Integrator::new(sys, newton.clone(), *scheme, true)
@@ -235,6 +271,7 @@ pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
             Integrator::new(sys, newton.clone(), Scheme::Hht { alpha: 0.0 }, false)
         }
     };
+    integ.notices = notices;
     if integ.dynamic {
         for iv in &model.initial {
             if let Some(i) = model.nodes.get_index_of(&iv.node) {
@@ -410,6 +447,9 @@ pub fn run_from(
                 integ.stats.max_step = integ.stats.max_step.max(h_try);
                 let v = integ.constraint_violation();
                 integ.stats.max_constraint_violation = integ.stats.max_constraint_violation.max(v);
+                if let Err(f) = integ.check_removed_equations() {
+                    failure = Some(f);
+                }
                 integ.stats.cpu_seconds = cpu0 + start.elapsed().as_secs_f64();
                 integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
                 pause_due = true;

@@ -137,6 +137,10 @@ pub enum StateError {
     /// The LU state does not fit the matrix.
     #[error(transparent)]
     Linear(#[from] LinearError),
+    /// The model's start (what a run does before its first step: redundant equations
+    /// removed, assembly) failed, so no state of a run of it can exist.
+    #[error("the model's start failed: {0}")]
+    Start(String),
 }
 
 impl IntegratorState {
@@ -180,9 +184,15 @@ impl Integrator {
     }
 
     /// Restores a [`Integrator::save_state`] into an integrator prepared from the same
-    /// model ([`super::prepare`], not initialised). Sizes are checked first: on error the
-    /// integrator is left as it was or partly restored, and must not be run.
+    /// model ([`super::prepare`]). The integrator is first started as the run was
+    /// ([`Integrator::initialize`], if not yet: the constraint equations removed as
+    /// redundant, the notices), which the state then overwrites. Sizes are checked first:
+    /// on error the integrator is left as it was or partly restored, and must not be run.
     pub fn restore_state(&mut self, s: IntegratorState) -> Result<(), StateError> {
+        if !self.started {
+            self.initialize()
+                .map_err(|f| StateError::Start(f.to_string()))?;
+        }
         let nn = self.nodes.len();
         let n = self.sys.n_eq();
         let ne = self.sys.elements.len();

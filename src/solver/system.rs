@@ -39,14 +39,21 @@ pub struct AppliedLoad {
     pub moment: bool,
     /// Global components at `f = 1`.
     pub value: Vector3<f64>,
-    /// Time function (`None` = 1).
+    /// Time function (`None` = 1, or the load factor in statics: `ramp`).
     pub function: Option<Function>,
+    /// A static analysis's load without a function: in proportion to the load factor `t`.
+    pub ramp: bool,
 }
 
 impl AppliedLoad {
-    /// Global load vector at time `t`.
+    /// Global load vector at time `t` (statics: load factor `t`).
     pub fn at(&self, t: f64) -> Vector3<f64> {
-        self.value * self.function.as_ref().map_or(1.0, |f| f.eval(t))
+        let f = match &self.function {
+            Some(f) => f.eval(t),
+            None if self.ramp => t.clamp(0.0, 1.0),
+            None => 1.0,
+        };
+        self.value * f
     }
 }
 
@@ -59,6 +66,9 @@ pub enum BuildError {
     /// The linear solver could not analyse the pattern.
     #[error(transparent)]
     Linear(#[from] LinearError),
+    /// Nodes with free translations that no element acts on ([`super::idle`]).
+    #[error("{}", .0.iter().map(|n| n.to_string()).collect::<Vec<_>>().join("\n"))]
+    Undetermined(Vec<super::idle::UndeterminedNode>),
 }
 
 /// The discretised model ready for time integration.
@@ -98,6 +108,12 @@ pub struct System {
     pub ref_force: f64,
     /// Size of the model's bounding box (≥ the longest element), m.
     pub ref_length: f64,
+    /// `ANALYSIS STATIC … PROPORTIONAL`: gravity and the loads without a function are
+    /// scaled by the load factor.
+    pub proportional: bool,
+    /// Multiplier equations removed as redundant ([`System::remove_equations`]), sorted,
+    /// with the matrix position of each one's diagonal.
+    removed: Vec<(usize, u32)>,
 }
 
 /// Magnitudes seen during an assembly (for convergence tests).
@@ -253,6 +269,14 @@ impl System {
                     .function
                     .and_then(|f| model.functions.get(&f))
                     .map(|f| f.function.clone()),
+                ramp: l.function.is_none()
+                    && matches!(
+                        model.analysis,
+                        crate::model::Analysis::Static {
+                            proportional: true,
+                            ..
+                        }
+                    ),
             })
             .collect();
         let gravity = model.gravity.unwrap_or_else(Vector3::zeros);
@@ -296,7 +320,56 @@ impl System {
             moment_blocks,
             ref_force,
             ref_length,
+            removed: Vec::new(),
+            proportional: matches!(
+                model.analysis,
+                crate::model::Analysis::Static {
+                    proportional: true,
+                    ..
+                }
+            ),
         })
+    }
+
+    /// Removes the multiplier equations `eqs` (global numbers) from the system: no
+    /// element's row or column reaches them any more, and each keeps only the equation
+    /// `s λ_k = 0` (its diagonal), so its multiplier is held at zero. For constraint
+    /// equations that depend on the others ([`super::redundancy`]): the numbering, the
+    /// elements' multiplier slices and the pattern stay as they are. Nodal equations are
+    /// refused (hold them by fixing the degree of freedom).
+    pub fn remove_equations(&mut self, eqs: &[usize]) {
+        for &g in eqs {
+            assert!(
+                matches!(self.owners.get(g), Some(DofOwner::Multiplier { .. })),
+                "only multiplier equations are removed"
+            );
+            if self.removed.iter().any(|(r, _)| *r == g) {
+                continue;
+            }
+            let pos = self
+                .matrix
+                .position(g, g)
+                .expect("the pattern holds the diagonal");
+            self.removed.push((g, pos as u32));
+            let DofOwner::Multiplier { element, k } = self.owners[g] else {
+                unreachable!()
+            };
+            let nl = 6 * self.elements[element].nodes().len() + k;
+            let rows = &mut self.rows[element];
+            rows[nl] = NONE;
+            let size = rows.len();
+            let map = &mut self.maps[element];
+            for j in 0..size {
+                map[nl * size + j] = NONE;
+                map[j * size + nl] = NONE;
+            }
+        }
+        self.removed.sort_unstable();
+    }
+
+    /// The multiplier equations removed ([`System::remove_equations`]), sorted.
+    pub fn removed_equations(&self) -> Vec<usize> {
+        self.removed.iter().map(|(g, _)| *g).collect()
     }
 
     /// Number of global equations.
@@ -375,6 +448,13 @@ impl System {
                         self.matrix.values[pos as usize] += local.tan[p];
                     }
                 }
+            }
+        }
+        // Removed equations: `s λ_k = 0`, so Newton sets their multipliers to zero.
+        for &(g, pos) in &self.removed {
+            self.rhs[g] = ctx.constraint_scale * lambda[g];
+            if tangent {
+                self.matrix.values[pos as usize] += ctx.constraint_scale;
             }
         }
         for l in &self.loads {

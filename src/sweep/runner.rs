@@ -204,11 +204,7 @@ fn run_fresh(
         // modes the `mode` quantities read), as `mecano-rs DECK` makes it.
         Ok(model) if model.modes.is_some() => {
             let n = model.modes.unwrap_or(1) as usize;
-            let about = if model.modes_rotating {
-                app::modes::About::Rotating
-            } else {
-                app::modes::About::Initial
-            };
+            let about = crate::modes::about::deck_about(&model);
             match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true) {
                 app::EXIT_OK => Ok(crate::solver::RunReport {
                     stats: Default::default(),

@@ -119,16 +119,30 @@ impl Builder<'_> {
             if n < 1 {
                 return Err(out_of_range("MODES", "0", ">= 1", s));
             }
-            // `ROTATING`: about the relative equilibrium of a hub driven at constant speed.
-            let rotating = c.keyword(&["ROTATING"]).is_some();
+            // `ROTATING`: about the relative equilibrium of a hub driven at constant speed;
+            // `STATIC [STEPS k]`: about the static equilibrium, reached in k load steps.
+            let about = c.keyword(&["ROTATING", "STATIC"]).map(|(k, _)| k);
+            let (mut steps, mut proportional) = (1, false);
+            if about == Some("STATIC") && c.keyword(&["STEPS"]).is_some() {
+                let (k, s) = c.uint("STEPS (number of load steps)")?;
+                if k < 1 {
+                    return Err(out_of_range("STEPS", "0", ">= 1", s));
+                }
+                steps = k;
+            }
+            if about == Some("STATIC") && c.keyword(&["PROPORTIONAL"]).is_some() {
+                proportional = true;
+            }
             c.finish()?;
             let analysis = Analysis::Static {
-                steps: 1,
+                steps,
                 newton: NewtonSettings::default(),
+                proportional,
             };
             self.set_analysis(analysis, span)?;
             self.modes = Some(n);
-            self.modes_rotating = rotating;
+            self.modes_rotating = about == Some("ROTATING");
+            self.modes_static = about == Some("STATIC");
             return Ok(());
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
@@ -138,7 +152,7 @@ impl Builder<'_> {
                 "NEWTON",
             ]
         } else {
-            &["STEPS", "TOL", "TOLINC", "MAXIT", "NEWTON"]
+            &["STEPS", "PROPORTIONAL", "TOL", "TOLINC", "MAXIT", "NEWTON"]
         };
         let mut seen = Seen::default();
         let mut newton = NewtonSettings::default();
@@ -149,6 +163,7 @@ impl Builder<'_> {
         let (mut tolpos, mut tolrot, mut growth, mut steps) = (None, None, 2.0, 1);
         let mut adaptive = None;
         let mut esdirk = None;
+        let mut proportional = false;
         let pos = |v: f64| v > 0.0;
         while let Some(t) = c.peek() {
             let Some((kw, ks)) = c.keyword(kws) else {
@@ -199,6 +214,7 @@ impl Builder<'_> {
                     let (v, _) = c.expect_keyword(&["FULL", "MODIFIED"], "FULL or MODIFIED")?;
                     newton.modified = v == "MODIFIED";
                 }
+                "PROPORTIONAL" => proportional = true,
                 _ => {
                     let (n, s) = c.uint("STEPS")?;
                     if n < 1 {
@@ -209,7 +225,11 @@ impl Builder<'_> {
             }
         }
         let analysis = if kind == "STATIC" {
-            Analysis::Static { steps, newton }
+            Analysis::Static {
+                steps,
+                newton,
+                proportional,
+            }
         } else {
             let miss = |what: &str| {
                 DeckError::new(

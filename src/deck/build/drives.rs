@@ -56,21 +56,8 @@ impl Builder<'_> {
         if c.keyword(&["AMPLITUDE"]).is_some() {
             amplitude = c.number("AMPLITUDE (factor a of a·f(t))")?.0;
         }
-        // The driven coordinate (a joint's angle or travel, a node's displacement or
-        // rotation) is 0 in the deck's geometry: a law that starts elsewhere would jump.
-        let start = amplitude * self.functions[&function].function.eval(0.0);
-        if start.abs() > 1e-12 * amplitude.abs().max(1.0) {
-            return Err(DeckError::new(
-                K::BadDrive {
-                    context: c.ctx.clone(),
-                    reason: format!(
-                        "the law a·f(t) is {start} at t = 0, where the driven motion starts \
-                         from 0 (the deck's geometry); shift the function so that f(0) = 0"
-                    ),
-                },
-                fs,
-            ));
-        }
+        // A law that does not start at 0 (the deck's geometry) is met before the first
+        // step: the solver's assembly moves the mechanism there (solver::assembly).
         Ok(Drive {
             function,
             amplitude,

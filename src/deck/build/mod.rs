@@ -58,6 +58,8 @@ struct Builder<'s> {
     modes: Option<u32>,
     /// `ANALYSIS MODES n ROTATING`.
     modes_rotating: bool,
+    /// `ANALYSIS MODES n STATIC`.
+    modes_static: bool,
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
@@ -154,6 +156,7 @@ pub(crate) fn build_model(
         analysis: None,
         modes: None,
         modes_rotating: false,
+        modes_static: false,
         output: None,
         divide: Vec::new(),
         hinge_refs: Vec::new(),
@@ -240,6 +243,7 @@ pub(crate) fn build_model(
         analysis,
         modes: b.modes,
         modes_rotating: b.modes_rotating,
+        modes_static: b.modes_static,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
         parameters: b.parameters,

@@ -19,6 +19,19 @@ impl Element for Came {
         &self.nodes
     }
 
+    /// The surface turns with its node, so its node's rotation always counts once in
+    /// contact. The roller's node: its rotation carries the roller's offset, and with a
+    /// radius and friction the friction's moment and the contact point's velocity; a
+    /// centred point (no offset, and no radius or no friction) leaves it untouched.
+    fn rotation_use(&self, k: usize) -> crate::elements::RotationUse {
+        use crate::elements::RotationUse;
+        if k == self.s || self.o_p != Vector3::zeros() || (self.rho > 0.0 && self.mu > 0.0) {
+            RotationUse::Always
+        } else {
+            RotationUse::Never
+        }
+    }
+
     fn evaluate(
         &self,
         ctx: &EvalContext,

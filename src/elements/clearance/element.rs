@@ -22,6 +22,18 @@ impl Element for Clearance {
         &self.nodes
     }
 
+    /// The bearing's axis turns with its node (always counts); the journal's rotation
+    /// enters only through friction (the moment of the friction force at its radius and
+    /// the surface's slip velocity).
+    fn rotation_use(&self, k: usize) -> crate::elements::RotationUse {
+        use crate::elements::RotationUse;
+        if k == 0 || self.mu > 0.0 {
+            RotationUse::Always
+        } else {
+            RotationUse::Never
+        }
+    }
+
     fn evaluate(
         &self,
         ctx: &EvalContext,

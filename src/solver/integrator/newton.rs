@@ -55,12 +55,13 @@ impl Integrator {
         Failure {
             time: self.t,
             step: h,
+            load_steps: !self.dynamic,
             reason,
             residual_history: history,
             worst: if routine {
-                String::new()
+                Box::default()
             } else if self.sys.n_eq() > 0 {
-                self.sys.describe(worst)
+                self.sys.describe(worst).into()
             } else {
                 "-".into()
             },
@@ -80,6 +81,9 @@ impl Integrator {
     pub fn try_step(&mut self, h: f64) -> Result<StepInfo, Failure> {
         if self.dynamic && self.esdirk.is_some() {
             return self.try_esdirk_step(h);
+        }
+        if !self.dynamic {
+            return self.try_static_step(h);
         }
         let t1 = self.t + h;
         let p = self.params;

@@ -9,19 +9,11 @@ impl Integrator {
     /// `[M  sBᵀ; sB  0] [v̇₀; λ̂₀] = [−r(q₀, v₀, 0); 0]` (acceleration-level constraints of
     /// scleronomic joints, exact for a start from rest).
     pub fn initialize(&mut self) -> Result<(), Failure> {
+        self.started = true;
         let n = self.sys.n_eq();
         let nn = self.sys.n_node_eq;
-        // An over-constrained mechanism makes every iteration matrix singular: stop at
-        // once, naming the redundant joints.
-        if n > nn
-            && let Some(msg) = crate::solver::redundancy::redundancy_error(&self.sys, &self.nodes)
-        {
-            return Err(self.failure(
-                0.0,
-                FailureReason::Singular(msg),
-                vec![],
-                self.sys.ref_force,
-            ));
+        if n > nn {
+            self.start_constraints()?;
         }
         // Stiffness part (c_a = 0), then with c_a = 1: the difference is the mass matrix.
         let ctx0 = EvalContext {
@@ -63,10 +55,77 @@ impl Integrator {
             self.scale = self.scale_for(0.0);
             return Ok(());
         }
-        // A driver prescribes a velocity `B v = a ḟ(0)`: the initial velocities are made
-        // consistent with it (and with every joint) before the accelerations are solved for.
+        // A driver prescribes a velocity `B v = a ḟ(0)`, and given velocities may violate
+        // the joints (a node off a joint's axis): the initial velocities are made
+        // consistent with every constraint before the accelerations are solved for (at
+        // rest and without drivers there is nothing to project).
         let drivers = self.sys.elements.iter().any(|e| e.rheonomic());
-        self.consistent_start(drivers)
+        let moving = self
+            .nodes
+            .iter()
+            .any(|s| s.v != Vector3::zeros() || s.w != Vector3::zeros());
+        self.consistent_start(n > nn && (drivers || moving))
+    }
+
+    /// Before the first step of a constrained model: the redundant constraint equations
+    /// found and removed ([`crate::solver::redundancy`]), the initial positions moved
+    /// onto the constraints ([`crate::solver::assembly`]), and the removed equations
+    /// checked to follow from the kept ones there (else the constraints contradict each
+    /// other). What was done is added to [`Integrator::notices`].
+    pub fn start_constraints(&mut self) -> Result<(), Failure> {
+        use crate::solver::notice::Notice;
+        use crate::solver::redundancy;
+        let t = self.t;
+        let mut red = redundancy::detect(&self.sys, &self.nodes, t);
+        self.sys.remove_equations(&red.globals());
+        let tol = CONSTRAINT_TOL.max(100.0 * f64::EPSILON * self.sys.ref_length);
+        match crate::solver::assembly::assemble_positions(&mut self.sys, &mut self.nodes, t, tol) {
+            Ok(Some(notice)) => {
+                self.notices.push(notice);
+                // The rank at the closed position is the one that counts.
+                let again = redundancy::detect(&self.sys, &self.nodes, t);
+                if again.removed.len() > red.removed.len() {
+                    self.sys.remove_equations(&again.globals());
+                }
+                red = redundancy::detect(&self.sys, &self.nodes, t);
+            }
+            Ok(None) => {}
+            Err(f) => {
+                return Err(self.failure(
+                    0.0,
+                    FailureReason::Constraints(f.to_string().into()),
+                    vec![],
+                    self.sys.ref_force,
+                ));
+            }
+        }
+        if let Some((v, r)) = red.removed_violation(&self.sys, &self.nodes, t)
+            && v > removed_tolerance(self.sys.ref_length)
+        {
+            return Err(self.failure(
+                0.0,
+                FailureReason::Constraints(format!(
+                    "the constraints contradict each other: element {}'s equation {} ({}) depends on the equations before it but is violated by {v:.3e} where they hold; two joints or drivers impose one motion differently",
+                    r.id.0,
+                    r.equation + 1,
+                    r.motion
+                ).into()),
+                vec![],
+                self.sys.ref_force,
+            ));
+        }
+        for (msg, r) in red.describe().into_iter().zip(group_starts(&red)) {
+            self.notices.push(Notice::Redundant {
+                element: r.0,
+                equations: r.1,
+                message: msg,
+            });
+        }
+        for &(equations, dofs) in &red.unchecked {
+            self.notices.push(Notice::Unchecked { equations, dofs });
+        }
+        self.redundancy = red;
+        Ok(())
     }
 
     /// Consistent accelerations and multipliers at the current state, from the equations
@@ -82,6 +141,11 @@ impl Integrator {
     /// [`Self::consistent_accelerations`], first making the velocities consistent with
     /// the constraints when `project` (the start of a run with drivers).
     fn consistent_start(&mut self, project: bool) -> Result<(), Failure> {
+        let given = project
+            && self
+                .nodes
+                .iter()
+                .any(|s| s.v != Vector3::zeros() || s.w != Vector3::zeros());
         let n = self.sys.n_eq();
         let nn = self.sys.n_node_eq;
         let ctx0 = EvalContext {
@@ -140,7 +204,7 @@ impl Integrator {
         }
         self.stats.factorizations += 1;
         if project {
-            self.project_velocities(&mut sc, s);
+            self.project_velocities(&mut sc, s, given);
             // The velocity-dependent forces at the projected velocities.
             self.sys.assemble(&ctx_m, &self.nodes, &sc.zero, false);
             for (r, f) in sc.rhs.iter_mut().zip(&self.sys.rhs[..nn]) {
@@ -219,6 +283,9 @@ impl Integrator {
             }
             let o = self.sys.mult_offset[e];
             for k in 0..el.multipliers() {
+                if self.redundancy.removed.iter().any(|r| r.global == o + k) {
+                    continue;
+                }
                 rhs[o + k] -= s * el.constraint_time_derivatives(t, k)[order - 1];
             }
         }
@@ -230,7 +297,7 @@ impl Integrator {
     /// matrix is the factored one of the acceleration solve; `B v` is read from its
     /// constraint rows. INITIAL velocities that contradict a driver are thus overridden
     /// (grammar.md, "Drivers").
-    fn project_velocities(&mut self, sc: &mut AccelerationScratch, s: f64) {
+    fn project_velocities(&mut self, sc: &mut AccelerationScratch, s: f64, given: bool) {
         let n = self.sys.n_eq();
         let nn = self.sys.n_node_eq;
         let fixed = crate::solver::system::FIXED;
@@ -274,5 +341,53 @@ impl Integrator {
                 }
             }
         }
+        // Given velocities that the projection changed are said (a driver's start from
+        // rest is what grammar.md's "Drivers" describes, and goes without saying).
+        if given {
+            let (mut dv, mut dw, mut node) = (0.0f64, 0.0f64, 0);
+            for (i, d) in self.sys.node_dofs.iter().enumerate() {
+                let get = |c: usize| if d[c] == fixed { 0.0 } else { rhs[d[c]] };
+                let v = Vector3::new(get(0), get(1), get(2)).norm();
+                let w = Vector3::new(get(3), get(4), get(5)).norm();
+                if v + w * self.sys.ref_length > dv + dw * self.sys.ref_length {
+                    node = i;
+                }
+                dv = dv.max(v);
+                dw = dw.max(w);
+            }
+            let scale = self.nodes.iter().fold(0.0f64, |m, s| {
+                m.max(s.v.norm()).max(s.w.norm() * self.sys.ref_length)
+            });
+            if dv + dw * self.sys.ref_length > 1e-9 * scale {
+                self.notices
+                    .push(crate::solver::notice::Notice::VelocitiesProjected {
+                        change: dv,
+                        angular_change: dw,
+                        node: self.sys.node_ids[node],
+                    });
+            }
+        }
     }
+}
+
+/// How far a removed (redundant) equation may drift from zero while the kept ones hold:
+/// they imply it exactly where the redundancy is structural, so only the kept equations'
+/// Newton tolerance times the loop's conditioning shows; 1e-7 of the model's size is far
+/// above that and far below any visible motion.
+pub(crate) fn removed_tolerance(ref_length: f64) -> f64 {
+    1e-7 * ref_length.max(1.0)
+}
+
+/// The removed equations grouped by element: (element, its equations, 1-based).
+fn group_starts(
+    red: &crate::solver::redundancy::Redundancy,
+) -> Vec<(crate::model::ElementId, Vec<usize>)> {
+    let mut out: Vec<(crate::model::ElementId, Vec<usize>)> = Vec::new();
+    for r in &red.removed {
+        match out.last_mut() {
+            Some((id, v)) if *id == r.id => v.push(r.equation + 1),
+            _ => out.push((r.id, vec![r.equation + 1])),
+        }
+    }
+    out
 }

@@ -1,0 +1,99 @@
+//! What the solver changed of a model or of its initial state before the first step, for
+//! the user to know: printed as warnings by the command line, listed in `summary.json`
+//! (`"notices"`), shown by `--check`.
+
+use crate::model::{ElementId, NodeId};
+
+/// One thing the solver did on its own before the first step.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Notice {
+    /// Nodes whose rotations no element acts on: held ([`super::idle`]).
+    HeldRotations {
+        /// The nodes.
+        nodes: Vec<NodeId>,
+    },
+    /// Constraint equations removed as redundant ([`super::redundancy`]).
+    Redundant {
+        /// The element.
+        element: ElementId,
+        /// Its equations (1-based).
+        equations: Vec<usize>,
+        /// The message.
+        message: String,
+    },
+    /// Constraint groups too large for the redundancy check.
+    Unchecked {
+        /// Equations of the group.
+        equations: usize,
+        /// Degrees of freedom it touches.
+        dofs: usize,
+    },
+    /// Initial positions and rotations moved onto the constraints ([`super::assembly`]).
+    Assembled {
+        /// Largest translation of a node, m, and the node.
+        moved: f64,
+        /// The node that moved most.
+        node: NodeId,
+        /// Largest rotation of a node, rad.
+        turned: f64,
+        /// The node that turned most.
+        turned_node: NodeId,
+        /// Constraint violation before, m or rad.
+        violation: f64,
+        /// Gauss–Newton iterations.
+        iterations: u32,
+    },
+    /// Initial velocities changed to satisfy the constraints.
+    VelocitiesProjected {
+        /// Largest change of a node's velocity, m/s.
+        change: f64,
+        /// Largest change of a node's angular velocity, rad/s.
+        angular_change: f64,
+        /// The node whose velocity changed most.
+        node: NodeId,
+    },
+}
+
+impl std::fmt::Display for Notice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Notice::HeldRotations { nodes } => {
+                let list: Vec<String> = nodes.iter().map(|n| n.0.to_string()).collect();
+                write!(
+                    f,
+                    "node{} {}: no element acts on {} rotations (no rotary inertia, no beam, no joint, no moment); they are held, as FIX RX RY RZ would",
+                    if nodes.len() > 1 { "s" } else { "" },
+                    list.join(", "),
+                    if nodes.len() > 1 { "their" } else { "its" }
+                )
+            }
+            Notice::Redundant { message, .. } => write!(f, "redundant constraints: {message}"),
+            Notice::Unchecked { equations, dofs } => write!(
+                f,
+                "a group of {equations} constraint equations on {dofs} degrees of freedom is too large to be checked for redundancy; a redundancy there is diagnosed only if the iteration matrix cannot be factored"
+            ),
+            Notice::Assembled {
+                moved,
+                node,
+                turned,
+                turned_node,
+                violation,
+                iterations,
+            } => write!(
+                f,
+                "assembly: the initial positions violated the constraints by up to {violation:.3e}; {iterations} Gauss–Newton iterations moved them onto the constraints, node {} by up to {moved:.3e} m, node {} turned by up to {turned:.3e} rad",
+                node.0, turned_node.0
+            ),
+            Notice::VelocitiesProjected {
+                change,
+                angular_change,
+                node,
+            } => write!(
+                f,
+                "the initial velocities were made consistent with the constraints (the smallest change in kinetic energy): by up to {change:.3e} m/s and {angular_change:.3e} rad/s (most at node {})",
+                node.0
+            ),
+        }
+    }
+}
