@@ -312,7 +312,7 @@ impl Observer for NodeRec<'_> {
 fn bad_drivers_are_located_deck_errors() {
     let head = "NODES\n 1 0 0 0 FIX ALL\n 2 1 0 0\n 3 0 1 0 FIX X\nFUNCTIONS\n 1 HAVERSINE 0 1\n 2 TABLE 0 0 1 1\n 3 CONSTANT 0.5\nELEMENTS\n";
     let tail = "\nANALYSIS DYNAMIC STEP 1e-3 END 1\n";
-    let cases: [(&str, usize, usize, &str); 12] = [
+    let cases: [(&str, usize, usize, &str); 11] = [
         (
             " 1 UJOINT 1 2 AXIS1 0 0 1 AXIS2 0 1 0 DRIVE 1",
             10,
@@ -341,12 +341,6 @@ fn bad_drivers_are_located_deck_errors() {
             "a second DRIVE",
         ),
         (" 1 PRESCRIBED 3 X FUNCTION 1", 10, 15, "fixed in X"),
-        (
-            " 1 PRISMATIC 1 2 AXIS 1 0 0 DRIVE 3",
-            10,
-            35,
-            "is 0.5 at t = 0",
-        ),
         (
             " 1 PRESCRIBED 2 Y FUNCTION 1\n 2 PRESCRIBED 2 Y FUNCTION 1 AMPLITUDE 2",
             11,

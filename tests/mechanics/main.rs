@@ -14,5 +14,6 @@ mod contact;
 mod drivers;
 mod dynamics;
 mod modes_sparse;
+mod planar_loops;
 mod rotation_props;
 mod springs;

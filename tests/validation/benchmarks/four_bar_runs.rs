@@ -57,7 +57,11 @@ fn four_bar_motion(
 /// t = i/steps), with the deck's Newton settings.
 fn as_static(mut m: Model, steps: u32) -> Model {
     if let mecano::model::Analysis::Dynamic { newton, .. } = m.analysis.clone() {
-        m.analysis = mecano::model::Analysis::Static { steps, newton };
+        m.analysis = mecano::model::Analysis::Static {
+            steps,
+            newton,
+            proportional: false,
+        };
     }
     m
 }
