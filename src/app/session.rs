@@ -125,7 +125,7 @@ impl Observer for Controlled<'_> {
                 std::thread::sleep(Duration::from_micros(100));
             }
         }
-        let stop = self.interrupts.stopping();
+        let stop = self.interrupts.stopping_at(integ.t);
         if let Some(plan) = self.plan {
             let due = stop
                 || match (plan.every, self.last) {
