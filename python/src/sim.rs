@@ -49,7 +49,7 @@ struct Inner {
 }
 
 /// A simulation of a deck you advance yourself (see the Python docstrings in mecano/).
-#[pyclass(module = "mecano", frozen)]
+#[pyclass(module = "mecano", frozen, subclass)]
 pub struct Simulation {
     inner: Mutex<Inner>,
     /// The error a Python law raised inside a step.
@@ -586,7 +586,7 @@ impl Simulation {
     }
 
     /// The histories so far (the deck's OUTPUT selection) and the summary.
-    fn run(slf: &Bound<'_, Self>) -> PyResult<RunData> {
+    fn run_data(slf: &Bound<'_, Self>) -> PyResult<RunData> {
         let this = slf.get();
         let mut inner = this.lock()?;
         let r = inner.start(&this.abort)?;
@@ -637,9 +637,14 @@ impl Simulation {
 
     /// A simulation restored from `dir`/checkpoint.bin (its deck read again from where it
     /// was, or `deck`; a deck whose text differs is refused).
-    #[staticmethod]
+    #[classmethod]
     #[pyo3(signature = (dir, deck = None))]
-    fn load(py: Python<'_>, dir: PathBuf, deck: Option<&Bound<'_, PyAny>>) -> PyResult<Simulation> {
+    fn load<'py>(
+        cls: &Bound<'py, pyo3::types::PyType>,
+        dir: PathBuf,
+        deck: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let py = cls.py();
         let c = checkpoint::read(&dir).map_err(|e| MecanoError::new_err(e.to_string()))?;
         let deck = match deck {
             Some(d) => Deck::of(d)?,
@@ -653,8 +658,8 @@ impl Simulation {
         } else {
             deck
         };
-        let sim = Self::new_from(deck);
-        sim.restore_from(c)?;
+        let sim = cls.call1((Py::new(py, deck)?,))?;
+        sim.cast::<Simulation>()?.get().restore_from(c)?;
         Ok(sim)
     }
 

@@ -22,8 +22,10 @@ pub struct MemoryRun {
 }
 
 /// The recorder with the interruption check of [`Interrupts::stopping_at`] at each pause.
-pub(crate) struct Recording<'a> {
+pub struct Recording<'a> {
+    /// Where the histories go.
     pub rec: &'a mut Recorder,
+    /// Read at each pause between steps: a stop ends the run there.
     pub interrupts: &'a Interrupts,
 }
 
