@@ -5,9 +5,11 @@
 # that environment, then `pytest python/tests`. `cargo test` runs this script
 # (tests/python.rs), so the README's one test command covers the Python package too.
 #
-# The wheel is built with Cargo's `test` profile (opt-level 2, as the tests) in the
-# workspace's target/: the library and its dependencies `cargo test` compiled are reused
-# (only PyO3, numpy and the extension crate are added). A release wheel for use is what
+# The wheel is built with the dev profile given the test profile's settings (opt-level 2,
+# line tables, no incremental: Cargo.toml's [profile.test]) in the workspace's target/, so
+# the library and its dependencies `cargo test` compiled are reused (Cargo hashes a
+# profile's settings, not its name): only PyO3, numpy and the extension crate are added.
+# (`--profile test` would build the crate's test harness.) A release wheel for use is what
 # `pip install ./python` builds.
 #
 # Environment: PYTHON (default python3), MECANO_PYTEST_ARGS (extra pytest arguments).
@@ -29,7 +31,9 @@ if [[ ! -x "$venv/bin/python" ]] || [[ "$(cat "$stamp" 2>/dev/null)" != "$want" 
 fi
 cd "$here"
 rm -f "$root"/target/wheels/mecano-*.whl
-"$venv/bin/maturin" build --quiet --profile test --interpreter "$venv/bin/python" \
+CARGO_PROFILE_DEV_OPT_LEVEL=2 CARGO_PROFILE_DEV_DEBUG=line-tables-only \
+    CARGO_PROFILE_DEV_INCREMENTAL=false \
+    "$venv/bin/maturin" build --quiet --interpreter "$venv/bin/python" \
     --out "$root/target/wheels"
 "$venv/bin/pip" install --quiet --force-reinstall --no-deps "$root"/target/wheels/mecano-*.whl
 cd "$root"

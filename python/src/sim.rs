@@ -14,6 +14,7 @@ use mecano::checkpoint::{self, Checkpoint};
 use mecano::elements::NodeState;
 use mecano::model::control::{Actuator, ControlData, ControlLaw, HeldValue, Sensor};
 use mecano::model::{ElementId, Model, NodeId};
+use mecano::output::Recorder;
 use mecano::solver::{self, Integrator, RunError, StepOutcome, Stepper};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
