@@ -435,6 +435,10 @@ impl Element for Control {
         }
     }
 
+    fn does_work(&self) -> bool {
+        true
+    }
+
     fn input_power(&self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) -> f64 {
         let u = self.value(ctx.t, nodes);
         if u.is_finite() {

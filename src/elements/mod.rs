@@ -446,6 +446,12 @@ pub trait Element: Send + Sync {
         false
     }
 
+    /// Whether the element delivers work through [`Element::input_power`]: a driver
+    /// (rheonomic, the default) or a controlled input ([`control::Control`]).
+    fn does_work(&self) -> bool {
+        self.rheonomic()
+    }
+
     /// Power the element's drivers deliver to the system at the state, W: for a driver
     /// row `Φ = g(q) − a f(t)` with multiplier `μ = sλ̂ + pΦ`, the constraint force `−Bᵀμ`
     /// does `−μ B v = −μ a ḟ` (on the constraint); the energy balance integrates it as
