@@ -30,8 +30,5 @@ fn python_package_tests_pass() {
     // pytest's closing line, for the record of `cargo test -- --nocapture`.
     println!("{text}");
     assert!(out.status.success(), "python/ci.sh failed:\n{text}");
-    assert!(
-        text.contains(" passed"),
-        "pytest ran no test:\n{text}"
-    );
+    assert!(text.contains(" passed"), "pytest ran no test:\n{text}");
 }

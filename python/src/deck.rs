@@ -65,9 +65,9 @@ impl Deck {
             .detach(|| mdeck::parse_deck_with(&text, &name, &set))
             .map_err(|e| deck_error(py, e))?;
         if refine > 1 {
-            model.refine(refine).map_err(|e| {
-                DeckError::new_err(format!("{name}: refined({refine}): {e}"))
-            })?;
+            model
+                .refine(refine)
+                .map_err(|e| DeckError::new_err(format!("{name}: refined({refine}): {e}")))?;
         }
         Ok(Deck {
             text,
@@ -96,8 +96,8 @@ impl Deck {
 
     fn read_path(py: Python<'_>, path: PathBuf) -> PyResult<Deck> {
         let name = path.display().to_string();
-        let too_large = std::fs::metadata(&path)
-            .is_ok_and(|m| m.len() > mdeck::limits::MAX_DECK_BYTES as u64);
+        let too_large =
+            std::fs::metadata(&path).is_ok_and(|m| m.len() > mdeck::limits::MAX_DECK_BYTES as u64);
         match (!too_large).then(|| std::fs::read(&path).map(String::from_utf8)) {
             Some(Ok(Ok(text))) => Self::parse(py, text, name, Some(path), Vec::new(), 1),
             // Missing, unreadable, too large or not UTF-8: the loader's own diagnostics.
@@ -172,7 +172,11 @@ impl Deck {
     /// The same deck with parameter overrides, e.g. `deck.with_parameters(E=2.1e10)`
     /// (names the deck's PARAMETERS; a name it does not define is a DeckError).
     #[pyo3(signature = (**values))]
-    fn with_parameters(&self, py: Python<'_>, values: Option<&Bound<'_, PyDict>>) -> PyResult<Deck> {
+    fn with_parameters(
+        &self,
+        py: Python<'_>,
+        values: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Deck> {
         let mut set = self.set.clone();
         if let Some(values) = values {
             for (k, v) in values.iter() {
@@ -180,7 +184,10 @@ impl Deck {
                 let v: f64 = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
                         "parameter {name}: expected a number, not {}",
-                        v.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+                        v.get_type()
+                            .name()
+                            .map(|n| n.to_string())
+                            .unwrap_or_default()
                     ))
                 })?;
                 finite(&format!("parameter {name}"), v)?;

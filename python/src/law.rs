@@ -77,12 +77,18 @@ impl Sensors {
 
     /// Node `node`'s global coordinate along `axis` (0, 1, 2), m.
     fn coordinate(&self, node: u32, axis: usize) -> PyResult<f64> {
-        self.find(Sensor::Coordinate(mecano::model::NodeId(node), check_axis(axis)?))
+        self.find(Sensor::Coordinate(
+            mecano::model::NodeId(node),
+            check_axis(axis)?,
+        ))
     }
 
     /// Node `node`'s global velocity component along `axis` (0, 1, 2), m/s.
     fn velocity(&self, node: u32, axis: usize) -> PyResult<f64> {
-        self.find(Sensor::Velocity(mecano::model::NodeId(node), check_axis(axis)?))
+        self.find(Sensor::Velocity(
+            mecano::model::NodeId(node),
+            check_axis(axis)?,
+        ))
     }
 
     fn __len__(&self) -> usize {

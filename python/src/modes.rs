@@ -1,8 +1,8 @@
 //! `mecano.modes`: the linearised modes of a deck, the numbers `mecano-rs modes` prints
 //! and writes (the same library call, [`mecano::modes::about::analyse_model`]).
 
-use crate::deck::{Deck, finite};
 use crate::MecanoError;
+use crate::deck::{Deck, finite};
 use mecano::modes::about::{self, About};
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -62,7 +62,8 @@ pub fn modes<'py>(
         }
     }
     let out = PyDict::new(py);
-    let col = |f: &dyn Fn(&mecano::modes::Mode) -> f64| -> Vec<f64> { a.modes.iter().map(f).collect() };
+    let col =
+        |f: &dyn Fn(&mecano::modes::Mode) -> f64| -> Vec<f64> { a.modes.iter().map(f).collect() };
     out.set_item("frequency_hz", col(&|m| m.frequency_hz).into_pyarray(py))?;
     out.set_item("natural_hz", col(&|m| m.natural_hz).into_pyarray(py))?;
     out.set_item("damping_ratio", col(&|m| m.damping_ratio).into_pyarray(py))?;

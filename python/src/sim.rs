@@ -159,9 +159,13 @@ impl Inner {
 
     fn element_row(&self, id: u32) -> PyResult<(Vec<String>, Vec<f64>)> {
         let r = self.running()?;
-        let e = self.model.elements.get_index_of(&ElementId(id)).ok_or_else(|| {
-            PyKeyError::new_err(format!("element {id} does not exist in {}", self.deck.name))
-        })?;
+        let e = self
+            .model
+            .elements
+            .get_index_of(&ElementId(id))
+            .ok_or_else(|| {
+                PyKeyError::new_err(format!("element {id} does not exist in {}", self.deck.name))
+            })?;
         let integ = &r.integ;
         let el = &integ.sys.elements[e];
         let lam = integ.sys.element_lambda(e, &integ.lambda);
@@ -202,7 +206,13 @@ impl Simulation {
             let laws = inner
                 .inputs
                 .iter()
-                .filter_map(|i| Some((i.id, i.explicit.as_ref()?.clone_ref(slf.py()), i.held.clone()?)))
+                .filter_map(|i| {
+                    Some((
+                        i.id,
+                        i.explicit.as_ref()?.clone_ref(slf.py()),
+                        i.held.clone()?,
+                    ))
+                })
                 .collect();
             (laws, inner.run.as_ref().map_or(0.0, |r| r.integ.t))
         };
@@ -220,7 +230,10 @@ impl Simulation {
             let v: f64 = r.extract(slf.py()).map_err(|_| {
                 fail(PyTypeError::new_err(format!(
                     "the law of input {id} returned {}, not a number",
-                    r.bind(slf.py()).repr().map(|x| x.to_string()).unwrap_or_default()
+                    r.bind(slf.py())
+                        .repr()
+                        .map(|x| x.to_string())
+                        .unwrap_or_default()
                 )))
             })?;
             if !v.is_finite() {
@@ -247,7 +260,10 @@ impl Simulation {
         }
         let mut inner = this.lock()?;
         inner.usable()?;
-        let end = inner.run.as_ref().map_or(end_time(&inner.model), |r| r.stepper.end);
+        let end = inner
+            .run
+            .as_ref()
+            .map_or(end_time(&inner.model), |r| r.stepper.end);
         let (interrupts, stop) = poll::interrupts(None, end);
         let inner_ref: &mut Inner = &mut inner;
         inner_ref.start(&this.abort)?;
@@ -338,7 +354,9 @@ impl Simulation {
             (Some(h), None, None) => Actuator::HingeTorque(ElementId(h)),
             (None, Some(n), Some(a)) => Actuator::NodeForce(NodeId(n), check_axis(a)?),
             (None, Some(_), None) => {
-                return Err(PyValueError::new_err("a force on a node needs its axis (0, 1, 2)"));
+                return Err(PyValueError::new_err(
+                    "a force on a node needs its axis (0, 1, 2)",
+                ));
             }
             _ => {
                 return Err(PyValueError::new_err(
@@ -469,7 +487,12 @@ impl Simulation {
     /// Steps until time `t` (s), landing on it; returns the time reached.
     fn advance(slf: &Bound<'_, Self>, t: f64) -> PyResult<f64> {
         finite("t", t)?;
-        let explicit = slf.get().lock()?.inputs.iter().any(|i| i.explicit.is_some());
+        let explicit = slf
+            .get()
+            .lock()?
+            .inputs
+            .iter()
+            .any(|i| i.explicit.is_some());
         if explicit {
             // A law called between steps: one step at a time, with the GIL in between.
             loop {
@@ -478,7 +501,9 @@ impl Simulation {
                     return Ok(now);
                 }
                 Self::explicit_laws(slf)?;
-                let o = Self::drive(slf, |stepper, integ, obs| stepper.step_toward(t, integ, obs))?;
+                let o = Self::drive(slf, |stepper, integ, obs| {
+                    stepper.step_toward(t, integ, obs)
+                })?;
                 if o != StepOutcome::Accepted {
                     return Self::t(slf);
                 }
@@ -504,13 +529,19 @@ impl Simulation {
     fn rotation<'py>(slf: &Bound<'py, Self>, node: u32) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (_, s, _) = started(slf)?.node(node)?;
         let r = s.r;
-        let rows: Vec<Vec<f64>> = (0..3).map(|i| (0..3).map(|j| r[(i, j)]).collect()).collect();
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|i| (0..3).map(|j| r[(i, j)]).collect())
+            .collect();
         PyArray2::from_vec2(slf.py(), &rows).map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
     /// Node `node`'s velocity (global, m/s), or its component along `axis`.
     #[pyo3(signature = (node, axis = None))]
-    fn velocity<'py>(slf: &Bound<'py, Self>, node: u32, axis: Option<usize>) -> PyResult<Py<PyAny>> {
+    fn velocity<'py>(
+        slf: &Bound<'py, Self>,
+        node: u32,
+        axis: Option<usize>,
+    ) -> PyResult<Py<PyAny>> {
         let (_, s, _) = started(slf)?.node(node)?;
         let py = slf.py();
         Ok(match axis {
@@ -526,7 +557,10 @@ impl Simulation {
     }
 
     /// Node `node`'s angular velocity (global, rad/s).
-    fn angular_velocity<'py>(slf: &Bound<'py, Self>, node: u32) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn angular_velocity<'py>(
+        slf: &Bound<'py, Self>,
+        node: u32,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let (_, s, _) = started(slf)?.node(node)?;
         Ok(v3(slf.py(), &(s.r * s.w)))
     }
@@ -568,7 +602,14 @@ impl Simulation {
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
         let (h, row) = started(slf)?.element_row(element)?;
         let col = |name: &str| h.iter().position(|c| c == name).map(|i| row[i]);
-        match (col("fx"), col("fy"), col("fz"), col("mx"), col("my"), col("mz")) {
+        match (
+            col("fx"),
+            col("fy"),
+            col("fz"),
+            col("mx"),
+            col("my"),
+            col("mz"),
+        ) {
             (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)) => Ok((
                 vec![a, b, c].into_pyarray(slf.py()),
                 vec![d, e, f].into_pyarray(slf.py()),
@@ -613,7 +654,9 @@ impl Simulation {
             .save_state()
             .map_err(|e| MecanoError::new_err(e.to_string()))?;
         let id = mecano::app::deck_identity(
-            deck.path.as_deref().unwrap_or(std::path::Path::new(&deck.name)),
+            deck.path
+                .as_deref()
+                .unwrap_or(std::path::Path::new(&deck.name)),
             &deck.text,
             &deck.set,
             deck.refine,
@@ -650,12 +693,23 @@ impl Simulation {
         let deck = match deck {
             Some(d) => Deck::of(d)?,
             None => {
-                let path = c.deck.absolute.clone().unwrap_or_else(|| c.deck.path.clone());
+                let path = c
+                    .deck
+                    .absolute
+                    .clone()
+                    .unwrap_or_else(|| c.deck.path.clone());
                 Deck::of(&pyo3::types::PyString::new(py, &path).into_any())?
             }
         };
         let deck = if deck.set != c.deck.set || deck.refine != c.deck.refine.max(1) {
-            Deck::parse(py, deck.text, deck.name, deck.path, c.deck.set.clone(), c.deck.refine)?
+            Deck::parse(
+                py,
+                deck.text,
+                deck.name,
+                deck.path,
+                c.deck.set.clone(),
+                c.deck.refine,
+            )?
         } else {
             deck
         };
@@ -699,8 +753,8 @@ impl Simulation {
                 inner.deck.name, c.deck.sha256, sha
             )));
         }
-        let mut integ = solver::prepare(&inner.model)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let mut integ =
+            solver::prepare(&inner.model).map_err(|e| PyValueError::new_err(e.to_string()))?;
         integ.abort = Some(self.abort.clone());
         integ.restore_state(c.integrator).map_err(|e| {
             MecanoError::new_err(format!(
@@ -739,7 +793,9 @@ fn started<'a>(slf: &'a Bound<'_, Simulation>) -> PyResult<MutexGuard<'a, Inner>
 fn sensor(inner: &Inner, s: Sensor, joint: u32) -> PyResult<f64> {
     let r = inner.running()?;
     if inner.model.hinge_nodes(ElementId(joint)).is_none() {
-        return Err(PyKeyError::new_err(format!("element {joint} is not a HINGE")));
+        return Err(PyKeyError::new_err(format!(
+            "element {joint} is not a HINGE"
+        )));
     }
     if let Sensor::HingeAngle(_) = s {
         // The joint's own angle, whole turns counted across steps.

@@ -102,8 +102,7 @@ pub fn run_in_memory(
     if report.interrupted.is_some()
         && let Some(signal) = interrupts.signal_name()
     {
-        rec.notes
-            .insert("signal".into(), serde_json::json!(signal));
+        rec.notes.insert("signal".into(), serde_json::json!(signal));
     }
     let summary = rec.finish(&integ, &report);
     Ok(MemoryRun {
@@ -125,8 +124,8 @@ mod tests {
         let path = std::path::Path::new("decks/driven_arm.dat");
         let mut model = crate::deck::load_deck(path).expect("deck");
         model.set_fixed_step(1e-3, 0.2, None);
-        let mem = run_in_memory(&model, "decks/driven_arm.dat", 1, &Interrupts::none())
-            .expect("runs");
+        let mem =
+            run_in_memory(&model, "decks/driven_arm.dat", 1, &Interrupts::none()).expect("runs");
         assert!(mem.report.failure.is_none());
         let dir = std::env::temp_dir().join(format!("mecano-memory-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);

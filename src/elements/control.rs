@@ -115,7 +115,11 @@ impl HingeAt {
     }
 
     /// `(sin-like, cos-like, g)` at the nodes; `None` when `Q p` is parallel to the axis.
-    fn at(&self, nodes: &[NodeState], dense: &[usize]) -> Option<(f64, Vector6<f64>, Vector6<f64>)> {
+    fn at(
+        &self,
+        nodes: &[NodeState],
+        dense: &[usize],
+    ) -> Option<(f64, Vector6<f64>, Vector6<f64>)> {
         let (a, b) = (&nodes[dense[self.k[0]]], &nodes[dense[self.k[1]]]);
         let (s, co, g) = self.grad(&a.r, &b.r);
         let n2 = s * s + co * co;
@@ -238,9 +242,10 @@ impl Control {
                         "a PID reads a hinge's angle and its rate".to_string(),
                     ));
                 }
-                let f = model.functions.get(&p.target).ok_or_else(|| {
-                    invalid(format!("function {} does not exist", p.target.0))
-                })?;
+                let f = model
+                    .functions
+                    .get(&p.target)
+                    .ok_or_else(|| invalid(format!("function {} does not exist", p.target.0)))?;
                 Resolved::Pid {
                     kp: p.kp,
                     ki: p.ki,
@@ -343,7 +348,9 @@ impl Control {
     /// The actuator's rate `ḋ·v` (θ̇ of the hinge, or `v_a` of the node).
     fn actuator_rate(&self, nodes: &[NodeState]) -> f64 {
         match self.actuator {
-            Reads::Angle(h, _) => h.at(nodes, &self.nodes).map_or(0.0, |(_, g, om)| g.dot(&om)),
+            Reads::Angle(h, _) => h
+                .at(nodes, &self.nodes)
+                .map_or(0.0, |(_, g, om)| g.dot(&om)),
             Reads::Coordinate(k, a) => nodes[self.nodes[k]].v[a],
             _ => 0.0,
         }

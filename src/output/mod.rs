@@ -33,10 +33,10 @@ use crate::model::Model;
 use crate::rotation;
 use crate::solver::{Failure, Interruption, Observer, RunReport, Snapshot, Stats, System};
 pub use history::History;
-pub use record::{Recorded, Recorder};
 use netcdf::Columnar;
 pub use plan::{CSV_NUMBER_BYTES, Volume, volume};
 use plan::{groups, plan};
+pub use record::{Recorded, Recorder};
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -467,49 +467,49 @@ pub fn summary_value(
     extra: Option<serde_json::Value>,
     notes: &serde_json::Map<String, serde_json::Value>,
 ) -> serde_json::Value {
-        let complete = report.is_some_and(|r| r.failure.is_none() && r.interrupted.is_none());
-        let mut v = serde_json::json!({
-            "deck": head.deck,
-            "title": head.title,
-            "effects": head.effects,
-            "end_time": head.end,
-            "complete": complete,
-            "refine": head.refine,
-            "generated": head.generated,
+    let complete = report.is_some_and(|r| r.failure.is_none() && r.interrupted.is_none());
+    let mut v = serde_json::json!({
+        "deck": head.deck,
+        "title": head.title,
+        "effects": head.effects,
+        "end_time": head.end,
+        "complete": complete,
+        "refine": head.refine,
+        "generated": head.generated,
+    });
+    if let Some(r) = report {
+        let st = &r.stats;
+        v["time_reached"] = serde_json::json!(r.time);
+        v["stop"] = if let Some(how) = r.interrupted {
+            serde_json::json!({
+                "reason": "interrupted",
+                "time": r.time,
+                "step": st.steps,
+                "at_step_end": how == Interruption::AtStep,
+            })
+        } else if let Some(f) = &r.failure {
+            serde_json::json!({ "reason": "failed", "time": f.time, "step": st.steps })
+        } else {
+            serde_json::Value::Null
+        };
+        v["stats"] = serde_json::to_value(st).unwrap_or_default();
+        v["newton_iterations_per_step"] = serde_json::json!(if st.steps > 0 {
+            st.newton_iterations as f64 / st.steps as f64
+        } else {
+            0.0
         });
-        if let Some(r) = report {
-            let st = &r.stats;
-            v["time_reached"] = serde_json::json!(r.time);
-            v["stop"] = if let Some(how) = r.interrupted {
-                serde_json::json!({
-                    "reason": "interrupted",
-                    "time": r.time,
-                    "step": st.steps,
-                    "at_step_end": how == Interruption::AtStep,
-                })
-            } else if let Some(f) = &r.failure {
-                serde_json::json!({ "reason": "failed", "time": f.time, "step": st.steps })
-            } else {
-                serde_json::Value::Null
-            };
-            v["stats"] = serde_json::to_value(st).unwrap_or_default();
-            v["newton_iterations_per_step"] = serde_json::json!(if st.steps > 0 {
-                st.newton_iterations as f64 / st.steps as f64
-            } else {
-                0.0
-            });
-            v["energy"] = serde_json::json!({ "max_balance_error": max_balance });
-            v["failure"] = match &r.failure {
-                Some(f) => failure_json(f),
-                None => serde_json::Value::Null,
-            };
-        }
-        if let Some(x) = extra {
-            v["elements"] = x;
-        }
-        for (k, x) in notes {
-            v[k] = x.clone();
-        }
+        v["energy"] = serde_json::json!({ "max_balance_error": max_balance });
+        v["failure"] = match &r.failure {
+            Some(f) => failure_json(f),
+            None => serde_json::Value::Null,
+        };
+    }
+    if let Some(x) = extra {
+        v["elements"] = x;
+    }
+    for (k, x) in notes {
+        v[k] = x.clone();
+    }
     v
 }
 

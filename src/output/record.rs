@@ -179,7 +179,11 @@ impl Recorder {
                 format!(
                     "refusing to record a non-finite value (a history of {} columns, {} {})",
                     r.columns.len(),
-                    if r.columns.len() == 9 { "energy" } else { "number" },
+                    if r.columns.len() == 9 {
+                        "energy"
+                    } else {
+                        "number"
+                    },
                     r.id
                 ),
             )),

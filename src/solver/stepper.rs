@@ -175,9 +175,7 @@ impl Stepper {
 
     /// Whether the run can take another step before `self.end`.
     pub fn running(&self, integ: &Integrator) -> bool {
-        self.failure.is_none()
-            && self.interrupted.is_none()
-            && integ.t < self.end - 1e-9 * self.h0
+        self.failure.is_none() && self.interrupted.is_none() && integ.t < self.end - 1e-9 * self.h0
     }
 
     /// Takes one accepted step (cutting and retrying refused attempts as the run loop
@@ -335,7 +333,10 @@ impl Stepper {
                 })?;
                 obs.progress(integ.t, end, &integ.stats);
                 if integ.dynamic
-                    && self.drive_breaks.iter().any(|b| (integ.t - b).abs() <= near)
+                    && self
+                        .drive_breaks
+                        .iter()
+                        .any(|b| (integ.t - b).abs() <= near)
                     && integ.consistent_accelerations().is_ok()
                 {
                     integ.stats.restarts += 1;

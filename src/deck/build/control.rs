@@ -30,10 +30,20 @@ impl Builder<'_> {
             };
             seen.add(kw, ks, &c.ctx)?;
             match kw {
-                "KP" => pid.kp = c.number_in("KP (proportional gain)", ">= 0 N·m/rad", |v| v >= 0.0)?,
-                "KI" => pid.ki = c.number_in("KI (integral gain)", ">= 0 N·m/(rad·s)", |v| v >= 0.0)?,
-                "KD" => pid.kd = c.number_in("KD (derivative gain)", ">= 0 N·m·s/rad", |v| v >= 0.0)?,
-                "AMPLITUDE" => pid.amplitude = c.number("AMPLITUDE (factor a of the target a·f(t))")?.0,
+                "KP" => {
+                    pid.kp = c.number_in("KP (proportional gain)", ">= 0 N·m/rad", |v| v >= 0.0)?
+                }
+                "KI" => {
+                    pid.ki =
+                        c.number_in("KI (integral gain)", ">= 0 N·m/(rad·s)", |v| v >= 0.0)?
+                }
+                "KD" => {
+                    pid.kd =
+                        c.number_in("KD (derivative gain)", ">= 0 N·m·s/rad", |v| v >= 0.0)?
+                }
+                "AMPLITUDE" => {
+                    pid.amplitude = c.number("AMPLITUDE (factor a of the target a·f(t))")?.0
+                }
                 _ => {
                     let (f, fs) = c.uint("the target's function number")?;
                     let function = self.function_ref(f, fs)?;

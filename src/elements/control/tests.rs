@@ -1,7 +1,7 @@
 use super::*;
 use crate::elements::testing::*;
-use crate::model::control::{HeldValue, Pid};
 use crate::model::FunctionId;
+use crate::model::control::{HeldValue, Pid};
 
 const PENDULUM: &str = include_str!("../../../decks/simple_pendulum.dat");
 const ARM: &str = include_str!("../../../decks/driven_arm.dat");
@@ -110,7 +110,10 @@ fn held_torque_and_sensors_on_hinge_motions() {
         },
     );
     let ctx = dyn_ctx();
-    let mut st = vec![NodeState::at_rest(Vector3::zeros()), NodeState::at_rest(Vector3::x())];
+    let mut st = vec![
+        NodeState::at_rest(Vector3::zeros()),
+        NodeState::at_rest(Vector3::x()),
+    ];
     // Three turns and a bit, committed step by step: the angle counts them.
     let n = 50;
     let total = 3.3 * std::f64::consts::TAU;
@@ -161,11 +164,17 @@ fn bad_references_are_refused() {
     };
     use crate::model::control::ControlError as E;
     assert_eq!(
-        m.add_control(ElementId(1), data(Actuator::HingeTorque(ElementId(1)), vec![])),
+        m.add_control(
+            ElementId(1),
+            data(Actuator::HingeTorque(ElementId(1)), vec![])
+        ),
         Err(E::Taken(1))
     );
     assert_eq!(
-        m.add_control(ElementId(5), data(Actuator::HingeTorque(ElementId(2)), vec![])),
+        m.add_control(
+            ElementId(5),
+            data(Actuator::HingeTorque(ElementId(2)), vec![])
+        ),
         Err(E::NotAHinge(2))
     );
     assert_eq!(
