@@ -5,6 +5,7 @@
 //! interrupted (SIGINT or SIGTERM: whole rows kept, a checkpoint to go on from with
 //! `mecano-rs resume`).
 
+pub mod memory;
 pub mod modes;
 pub mod outdir;
 mod resume;

@@ -12,8 +12,13 @@ use signal_hook::iterator::Signals;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 
+/// A hook a run calls at each pause between steps with the time reached, before it reads
+/// [`Interrupts::stop`]: an embedding program (the Python package) polls its own signals
+/// there (Python's SIGINT handler runs only when the interpreter is asked) and sets `stop`.
+pub type PollHook = Arc<dyn Fn(f64) + Send + Sync>;
+
 /// The flags the signals set.
-#[derive(Debug, Clone, Default)]
+#[derive(Clone, Default)]
 pub struct Interrupts {
     /// Set by the first signal: end at the end of the step under way.
     pub stop: Arc<AtomicBool>,
@@ -21,6 +26,19 @@ pub struct Interrupts {
     pub abort: Arc<AtomicBool>,
     /// The last signal received (0 = none).
     signal: Arc<AtomicI32>,
+    /// Called at each pause between steps ([`Interrupts::stopping_at`]); `None` = nothing.
+    pub poll: Option<PollHook>,
+}
+
+impl std::fmt::Debug for Interrupts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Interrupts")
+            .field("stop", &self.stop)
+            .field("abort", &self.abort)
+            .field("signal", &self.signal)
+            .field("poll", &self.poll.is_some())
+            .finish()
+    }
 }
 
 impl Interrupts {
@@ -47,9 +65,41 @@ impl Interrupts {
         Ok(me)
     }
 
+    /// Flags no signal sets, with a [`PollHook`] that may set [`Interrupts::stop`].
+    pub fn polled(poll: PollHook) -> Self {
+        Interrupts {
+            poll: Some(poll),
+            ..Self::default()
+        }
+    }
+
+    /// The same flags without the [`PollHook`] (for the hook itself to hold: no cycle).
+    pub fn flags(&self) -> Self {
+        Interrupts {
+            poll: None,
+            ..self.clone()
+        }
+    }
+
+    /// At a pause between steps at time `t`: calls the [`PollHook`], then says whether a
+    /// stop was asked for.
+    pub fn stopping_at(&self, t: f64) -> bool {
+        if let Some(p) = &self.poll {
+            p(t);
+        }
+        self.stopping()
+    }
+
     /// Whether a stop was asked for.
     pub fn stopping(&self) -> bool {
         self.stop.load(Ordering::SeqCst)
+    }
+
+    /// Records that a stop was asked for by `signal` (e.g. `libc::SIGINT` seen by an
+    /// embedding program's own handler, [`Interrupts::poll`]).
+    pub fn request_stop(&self, signal: i32) {
+        self.signal.store(signal, Ordering::SeqCst);
+        self.stop.store(true, Ordering::SeqCst);
     }
 
     /// The name of the last signal received (`SIGINT`, `SIGTERM`), if any.

@@ -135,7 +135,7 @@ impl Observer for Controlled<'_> {
                 std::thread::sleep(Duration::from_micros(100));
             }
         }
-        let stop = self.interrupts.stopping();
+        let stop = self.interrupts.stopping_at(integ.t);
         if let Some(plan) = self.plan {
             let due = stop
                 || match (plan.every, self.last) {
@@ -227,17 +227,7 @@ impl Session<'_> {
                 RunReport {
                     stats: integ.stats,
                     time: integ.t,
-                    failure: Some(solver::Failure {
-                        time: integ.t,
-                        step: 0.0,
-                        load_steps: !integ.dynamic,
-                        reason: solver::FailureReason::NotFinite,
-                        residual_history: vec![],
-                        worst: format!("output: {e}").into(),
-                        worst_value: 0.0,
-                        reference_force: 0.0,
-                        diagnoses: Box::default(),
-                    }),
+                    failure: Some(solver::Failure::output(integ, &e)),
                     interrupted: None,
                 }
             }

@@ -371,6 +371,19 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
     ),
     kw(
+        "PID",
+        "ELEMENTS",
+        "PID controller: a torque on a HINGE element from its angle's error to a target a·f(t)",
+    ),
+    kw("KP", "ELEMENTS", "PID: proportional gain, N·m/rad (>= 0)"),
+    kw("KI", "ELEMENTS", "PID: integral gain, N·m/(rad·s) (>= 0)"),
+    kw("KD", "ELEMENTS", "PID: derivative gain, N·m·s/rad (>= 0)"),
+    kw(
+        "TARGET",
+        "ELEMENTS",
+        "PID: function number of the target angle f(t) (exact derivatives; AMPLITUDE a scales it)",
+    ),
+    kw(
         "CLEARANCE",
         "ELEMENTS",
         "revolute joint with radial clearance (element type; and its clearance, m)",

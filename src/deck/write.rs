@@ -203,6 +203,10 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 None => match &e.kind {
                     ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
+                    ElementKind::Control(c) => match c.actuator {
+                        crate::model::control::Actuator::HingeTorque(h) => vec![h.0.to_string()],
+                        crate::model::control::Actuator::NodeForce(n, _) => vec![n.0.to_string()],
+                    },
                     _ => e.nodes.iter().map(|n| n.0.to_string()).collect(),
                 },
             };
@@ -294,6 +298,15 @@ pub fn write_deck(model: &Model) -> String {
                     if b.axes != Matrix3::identity() {
                         let col = |i: usize| v3(&b.axes.column(i).into_owned());
                         let _ = write!(s, " AXES {} {}", col(0), col(1));
+                    }
+                }
+                ElementKind::Control(c) => {
+                    if let crate::model::control::ControlLaw::Pid(p) = &c.law {
+                        let _ = write!(
+                            s,
+                            " KP {:?} KI {:?} KD {:?} TARGET {} AMPLITUDE {:?}",
+                            p.kp, p.ki, p.kd, p.target.0, p.amplitude
+                        );
                     }
                 }
                 ElementKind::RSpring(r) => {

@@ -20,6 +20,7 @@ pub mod beam_p;
 pub mod bushing;
 pub mod came;
 pub mod clearance;
+pub mod control;
 pub mod drive;
 pub mod joints;
 pub mod mass;
@@ -123,6 +124,9 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                 })?;
                 out.push(Box::new(c));
             }
+            ElementKind::Control(data) => {
+                out.push(Box::new(control::Control::from_model(model, el, data)?))
+            }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
             ElementKind::Spring(_) | ElementKind::Bushing(_) | ElementKind::RSpring(_) => {
                 out.push(spring::from_model(model, el)?)
@@ -155,6 +159,14 @@ pub enum ElementState {
     RSpring(f64),
     /// A revolute joint with clearance ([`clearance::Clearance`]).
     Clearance(clearance::ClearanceState),
+    /// A controlled input ([`control::Control`]): its angle sensors' last angles (turns
+    /// counted) and a PID's `[I_n, e_n, t_n]`.
+    Control {
+        /// Angles of the angle sensors, rad.
+        angles: Vec<f64>,
+        /// The PID's integral, error and time at the last accepted state.
+        pid: [f64; 3],
+    },
 }
 
 /// A saved [`ElementState`] that does not belong to the element it is given to.
@@ -432,6 +444,12 @@ pub trait Element: Send + Sync {
     /// Whether a constraint of the element depends on time (a driver). Default: no.
     fn rheonomic(&self) -> bool {
         false
+    }
+
+    /// Whether the element delivers work through [`Element::input_power`]: a driver
+    /// (rheonomic, the default) or a controlled input ([`control::Control`]).
+    fn does_work(&self) -> bool {
+        self.rheonomic()
     }
 
     /// Power the element's drivers deliver to the system at the state, W: for a driver

@@ -8,6 +8,7 @@
 
 pub mod arc;
 mod clearance;
+pub mod control;
 mod drive;
 mod expr;
 mod function;
@@ -219,6 +220,9 @@ pub enum ElementKind {
     },
     /// Revolute joint with radial clearance (first node: bearing, second: journal).
     Clearance(Box<ClearanceData>),
+    /// A controlled input: a hinge torque or nodal force depending on sensors of the
+    /// state ([`control`]); its nodes are the actuator's and the sensors'.
+    Control(Box<control::ControlData>),
 }
 
 impl ElementKind {
@@ -239,6 +243,10 @@ impl ElementKind {
             ElementKind::RSpring(_) => "RSPRING",
             ElementKind::Prescribed { .. } => "PRESCRIBED",
             ElementKind::Clearance(_) => "CLEARANCE",
+            ElementKind::Control(c) => match c.law {
+                control::ControlLaw::Pid(_) => "PID",
+                _ => "CONTROL",
+            },
         }
     }
 

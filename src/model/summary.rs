@@ -144,6 +144,8 @@ impl Model {
                     e.friction |= r.friction > 0.0;
                 }
                 ElementKind::Prescribed { .. } => e.drivers = true,
+                // A controlled input is an applied load that depends on the state.
+                ElementKind::Control(_) => e.applied_loads = true,
             }
         }
         e

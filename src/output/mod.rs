@@ -25,6 +25,7 @@ mod history;
 pub mod netcdf;
 mod plan;
 pub mod read;
+mod record;
 mod stream;
 pub mod vtk;
 
@@ -35,6 +36,7 @@ pub use history::History;
 use netcdf::Columnar;
 pub use plan::{CSV_NUMBER_BYTES, Volume, volume};
 use plan::{groups, plan};
+pub use record::{Recorded, Recorder};
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -98,9 +100,7 @@ pub struct Writer {
     /// `histories.nc` (`OUTPUT FORMAT NETCDF`), with its nodes and elements (dense
     /// indices, elements in the order of its groups) in place of the CSVs.
     columnar: Option<(Columnar, Vec<usize>, Vec<usize>)>,
-    e0: Option<f64>,
-    energy_scale: f64,
-    max_balance: f64,
+    balance: Balance,
     last_row: Option<u64>,
     /// An element's row, reused (no allocation per row).
     row: Vec<f64>,
@@ -237,9 +237,11 @@ impl Writer {
         let nodes: Vec<(usize, Stream)> = node_files.iter().map(|(i, _)| *i).zip(streams).collect();
         let mut w = Self::with_streams(dir, deck, model, nodes, elements, energy);
         w.columnar = columnar;
-        w.e0 = state.e0;
-        w.energy_scale = state.energy_scale;
-        w.max_balance = state.max_balance;
+        w.balance = Balance {
+            e0: state.e0,
+            scale: state.energy_scale,
+            max: state.max_balance,
+        };
         w.last_row = state.last_row;
         if let Some(sampling) = state.sampling {
             w.sampling = sampling;
@@ -272,9 +274,7 @@ impl Writer {
             elements,
             energy,
             columnar: None,
-            e0: None,
-            energy_scale: 0.0,
-            max_balance: 0.0,
+            balance: Balance::default(),
             last_row: None,
             row: Vec::new(),
             progress: None,
@@ -299,9 +299,9 @@ impl Writer {
         }
         Ok(WriterState {
             files,
-            e0: self.e0,
-            energy_scale: self.energy_scale,
-            max_balance: self.max_balance,
+            e0: self.balance.e0,
+            energy_scale: self.balance.scale,
+            max_balance: self.balance.max,
             last_row: self.last_row,
             sampling: Some(self.sampling),
         })
@@ -361,31 +361,7 @@ impl Writer {
                 c.put(&self.row[1..]);
             }
         }
-        let e = integ.energies();
-        let total = e.kinetic + e.strain + e.gravity;
-        let e0 = *self.e0.get_or_insert(total);
-        let numerical = integ.external_work - integ.damping_work - (total - e0);
-        let residual = -numerical;
-        self.energy_scale = self
-            .energy_scale
-            .max(e0.abs())
-            .max(integ.external_work.abs())
-            .max(e.kinetic)
-            .max(e.strain.abs());
-        if integ.dynamic && self.energy_scale > 0.0 {
-            self.max_balance = self.max_balance.max(residual / self.energy_scale);
-        }
-        let row = [
-            t,
-            e.kinetic,
-            e.strain,
-            e.gravity,
-            total,
-            integ.external_work,
-            integ.damping_work,
-            numerical,
-            residual,
-        ];
+        let row = self.balance.row(integ);
         self.energy.row(&row)?;
         if let Some((c, _, _)) = &mut self.columnar {
             c.put(&row[1..]);
@@ -411,49 +387,20 @@ impl Writer {
         report: Option<&RunReport>,
         extra: Option<serde_json::Value>,
     ) -> io::Result<()> {
-        let complete = report.is_some_and(|r| r.failure.is_none() && r.interrupted.is_none());
-        let mut v = serde_json::json!({
-            "deck": self.deck,
-            "title": self.title,
-            "effects": self.effects,
-            "end_time": self.end,
-            "complete": complete,
-            "refine": self.refine,
-            "generated": self.generated,
-        });
-        if let Some(r) = report {
-            let st = &r.stats;
-            v["time_reached"] = serde_json::json!(r.time);
-            v["stop"] = if let Some(how) = r.interrupted {
-                serde_json::json!({
-                    "reason": "interrupted",
-                    "time": r.time,
-                    "step": st.steps,
-                    "at_step_end": how == Interruption::AtStep,
-                })
-            } else if let Some(f) = &r.failure {
-                serde_json::json!({ "reason": "failed", "time": f.time, "step": st.steps })
-            } else {
-                serde_json::Value::Null
-            };
-            v["stats"] = serde_json::to_value(st).unwrap_or_default();
-            v["newton_iterations_per_step"] = serde_json::json!(if st.steps > 0 {
-                st.newton_iterations as f64 / st.steps as f64
-            } else {
-                0.0
-            });
-            v["energy"] = serde_json::json!({ "max_balance_error": self.max_balance });
-            v["failure"] = match &r.failure {
-                Some(f) => failure_json(f),
-                None => serde_json::Value::Null,
-            };
-        }
-        if let Some(x) = extra {
-            v["elements"] = x;
-        }
-        for (k, x) in &self.notes {
-            v[k] = x.clone();
-        }
+        let v = summary_value(
+            &SummaryHead {
+                deck: &self.deck,
+                title: &self.title,
+                effects: &self.effects,
+                end: self.end,
+                refine: self.refine,
+                generated: &self.generated,
+            },
+            report,
+            self.balance.max,
+            extra,
+            &self.notes,
+        );
         let text = serde_json::to_string_pretty(&v).unwrap_or_else(|_| "{}".into());
         let tmp = self.dir.join("summary.json.tmp");
         fs::write(&tmp, text)?;
@@ -484,25 +431,151 @@ impl Writer {
             Ok(())
         };
         let flushed = self.flush();
-        let mut per_elem = serde_json::Map::new();
-        for el in &integ.sys.elements {
-            if let Some(s) = el.summary() {
-                per_elem.insert(el.id().0.to_string(), s);
-            }
-        }
-        let extra = (!per_elem.is_empty()).then_some(serde_json::Value::Object(per_elem));
+        let extra = element_facts(integ);
         self.write_summary(Some(report), extra)?;
         last.and(flushed)
     }
 
     /// Largest relative energy-balance error so far.
     pub fn max_balance_error(&self) -> f64 {
-        self.max_balance
+        self.balance.max
+    }
+}
+
+/// What `summary.json` says of a run besides its report: the deck, its title, its
+/// effects, the end time, the refinement and the generated nodes and elements.
+pub struct SummaryHead<'a> {
+    /// The deck's name (its path as given).
+    pub deck: &'a str,
+    /// The deck's title.
+    pub title: &'a str,
+    /// Active effects ([`crate::model::Effects::names`]).
+    pub effects: &'a [&'static str],
+    /// End time, s.
+    pub end: f64,
+    /// The `--refine` factor.
+    pub refine: u32,
+    /// Nodes and elements generated by dividing beams.
+    pub generated: &'a crate::model::Generated,
+}
+
+/// The content of `summary.json` (before the run ends: `report = None`, `"complete":
+/// false`), shared by the [`Writer`] and the in-memory [`Recorder`] so that both say the
+/// same: `max_balance` the largest relative energy-balance error, `extra` the elements'
+/// facts, `notes` the application's entries.
+pub fn summary_value(
+    head: &SummaryHead,
+    report: Option<&RunReport>,
+    max_balance: f64,
+    extra: Option<serde_json::Value>,
+    notes: &serde_json::Map<String, serde_json::Value>,
+) -> serde_json::Value {
+    let complete = report.is_some_and(|r| r.failure.is_none() && r.interrupted.is_none());
+    let mut v = serde_json::json!({
+        "deck": head.deck,
+        "title": head.title,
+        "effects": head.effects,
+        "end_time": head.end,
+        "complete": complete,
+        "refine": head.refine,
+        "generated": head.generated,
+    });
+    if let Some(r) = report {
+        let st = &r.stats;
+        v["time_reached"] = serde_json::json!(r.time);
+        v["stop"] = if let Some(how) = r.interrupted {
+            serde_json::json!({
+                "reason": "interrupted",
+                "time": r.time,
+                "step": st.steps,
+                "at_step_end": how == Interruption::AtStep,
+            })
+        } else if let Some(f) = &r.failure {
+            serde_json::json!({ "reason": "failed", "time": f.time, "step": st.steps })
+        } else {
+            serde_json::Value::Null
+        };
+        v["stats"] = serde_json::to_value(st).unwrap_or_default();
+        v["newton_iterations_per_step"] = serde_json::json!(if st.steps > 0 {
+            st.newton_iterations as f64 / st.steps as f64
+        } else {
+            0.0
+        });
+        v["energy"] = serde_json::json!({ "max_balance_error": max_balance });
+        v["failure"] = match &r.failure {
+            Some(f) => failure_json(f),
+            None => serde_json::Value::Null,
+        };
+    }
+    if let Some(x) = extra {
+        v["elements"] = x;
+    }
+    for (k, x) in notes {
+        v[k] = x.clone();
+    }
+    v
+}
+
+/// The elements' facts for `summary.json` ([`crate::elements::Element::summary`]), by
+/// element number; `None` when no element has any.
+pub fn element_facts(integ: &crate::solver::Integrator) -> Option<serde_json::Value> {
+    let mut per_elem = serde_json::Map::new();
+    for el in &integ.sys.elements {
+        if let Some(s) = el.summary() {
+            per_elem.insert(el.id().0.to_string(), s);
+        }
+    }
+    (!per_elem.is_empty()).then_some(serde_json::Value::Object(per_elem))
+}
+
+/// The energy balance's accumulators (module docs): the initial energy, the scale the
+/// balance error is relative to, and its largest value so far.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Balance {
+    e0: Option<f64>,
+    scale: f64,
+    max: f64,
+}
+
+impl Balance {
+    /// The row of `energy.csv` ([`ENERGY_HEADER`]) at the integrator's state, the
+    /// accumulators updated: `D_num = W_ext − D_c − (E − E(0))`, residual `−D_num`.
+    pub fn row(&mut self, integ: &crate::solver::Integrator) -> [f64; 9] {
+        let e = integ.energies();
+        let total = e.kinetic + e.strain + e.gravity;
+        let e0 = *self.e0.get_or_insert(total);
+        let numerical = integ.external_work - integ.damping_work - (total - e0);
+        let residual = -numerical;
+        self.scale = self
+            .scale
+            .max(e0.abs())
+            .max(integ.external_work.abs())
+            .max(e.kinetic)
+            .max(e.strain.abs());
+        if integ.dynamic && self.scale > 0.0 {
+            self.max = self.max.max(residual / self.scale);
+        }
+        [
+            integ.t,
+            e.kinetic,
+            e.strain,
+            e.gravity,
+            total,
+            integ.external_work,
+            integ.damping_work,
+            numerical,
+            residual,
+        ]
+    }
+
+    /// Largest relative energy-balance error so far.
+    pub fn max_error(&self) -> f64 {
+        self.max
     }
 }
 
 /// A node's row of `node_<N>.csv` ([`NODE_HEADER`]).
-fn node_row(integ: &crate::solver::Integrator, i: usize) -> [f64; 19] {
+pub fn node_row(integ: &crate::solver::Integrator, i: usize) -> [f64; 19] {
     let s = &integ.nodes[i];
     let u = s.x - integ.sys.x0[i];
     let phi = rotation::log(&s.r);

@@ -12,13 +12,14 @@ pub mod linear;
 pub mod notice;
 pub mod redundancy;
 pub mod state;
+pub mod stepper;
 pub mod system;
 
 pub use integrator::{AlphaParams, Integrator, StepInfo};
+pub use stepper::{StepOutcome, Stepper};
 pub use system::{BuildError, System};
 
 use crate::model::{Analysis, Model, Scheme};
-use std::time::Instant;
 
 /// Counters of a run (written to `summary.json`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -106,6 +107,24 @@ pub struct Failure {
     /// e.g. a universal joint at its singular configuration. (A boxed slice keeps
     /// `Failure` small: it travels in `Result`s.)
     pub diagnoses: Box<[String]>,
+}
+
+impl Failure {
+    /// The diagnosis of a run stopped by its output (a writer refused a non-finite value,
+    /// or the disk failed) at the integrator's last accepted state.
+    pub fn output(integ: &Integrator, e: &std::io::Error) -> Self {
+        Failure {
+            time: integ.t,
+            step: 0.0,
+            load_steps: !integ.dynamic,
+            reason: FailureReason::NotFinite,
+            residual_history: vec![],
+            worst: format!("output: {e}").into(),
+            worst_value: 0.0,
+            reference_force: 0.0,
+            diagnoses: Box::default(),
+        }
+    }
 }
 
 impl std::fmt::Display for Failure {
@@ -320,202 +339,9 @@ pub fn run_from(
     obs: &mut dyn Observer,
     resume: Option<LoopState>,
 ) -> Result<RunReport, RunError> {
-    let start = Instant::now();
-    let cpu0 = if resume.is_some() {
-        integ.stats.cpu_seconds
-    } else {
-        0.0
-    };
-    let (end, h0, hmin, hmax) = match &model.analysis {
-        Analysis::Dynamic {
-            step,
-            end,
-            min_step,
-            max_step,
-            ..
-        } => (*end, *step, *min_step, *max_step),
-        Analysis::Static { steps, .. } => {
-            let h = 1.0 / f64::from((*steps).max(1));
-            (1.0, h, h / 1024.0, h)
-        }
-    };
-    if let Analysis::Dynamic { adaptive, .. } = &model.analysis {
-        integ.adaptive = adaptive.clone();
-    }
-    let adaptive = integ.adaptive.is_some();
-    integ.event_floor = hmin;
-    let mut failure = None;
-    if resume.is_none() {
-        integ.stats.min_step = f64::INFINITY;
-        failure = integ.initialize().err();
-        if failure.is_none() {
-            obs.state(&Snapshot {
-                integ,
-                step: 0,
-                h: 0.0,
-            })?;
-        }
-    }
-    // Breakpoints of load functions: steps land on them rather than straddle a kink.
-    let mut breaks: Vec<f64> = integ
-        .sys
-        .loads
-        .iter()
-        .filter_map(|l| l.function.as_ref())
-        .flat_map(|f| f.breakpoints())
-        .filter(|t| *t > 0.0 && *t < end)
-        .collect();
-    // Drivers' breakpoints too: there a prescribed acceleration may jump (the haversine's
-    // ends), and the accelerations restart from the law's new value once a step lands on
-    // one (as after a contact's touch: no step straddles the jump).
-    let mut drive_breaks: Vec<f64> = model
-        .driver_functions()
-        .iter()
-        .flat_map(|f| f.breakpoints())
-        .filter(|t| *t > 0.0 && *t < end)
-        .collect();
-    drive_breaks.sort_by(f64::total_cmp);
-    breaks.extend_from_slice(&drive_breaks);
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup();
-    let ctl = resume.unwrap_or(LoopState {
-        h: h0,
-        good: 0,
-        retry: None,
-    });
-    let mut h = ctl.h;
-    let mut good = ctl.good;
-    let eps = 1e-9 * h0;
-    // A step an element asked for after refusing one (an event's time): tried once, the
-    // nominal step `h` stays as it was.
-    let mut retry: Option<f64> = ctl.retry;
-    // Pauses come after the initial state and after each accepted step (not after a
-    // refused attempt, nor at once after a restart: that state was the last pause's).
-    let mut pause_due = resume.is_none();
-    let mut interrupted = None;
-    while failure.is_none() && integ.t < end - eps {
-        if pause_due {
-            pause_due = false;
-            let ctl = LoopState { h, good, retry };
-            if obs.pause(integ, &ctl)? == Pause::Stop {
-                interrupted = Some(Interruption::AtStep);
-                break;
-            }
-        }
-        let t = integ.t;
-        let mut h_try = retry
-            .take()
-            .unwrap_or(h)
-            .min(end - t)
-            .min(integ.step_cap.max(hmin));
-        if !adaptive {
-            // Fixed steps come back to the grid t = k h₀ after an event moved them off it,
-            // so that histories keep their sampling times.
-            // (t is a sum of steps: "on the grid" within round-off, and never a sliver.)
-            let k = (t / h0).round();
-            let next_grid = if (t - k * h0).abs() <= 1e-6 * h0 {
-                (k + 1.0) * h0
-            } else {
-                (t / h0).ceil() * h0
-            };
-            let mut to_grid = next_grid - t;
-            if to_grid < 1e-3 * h0 {
-                to_grid += h0;
-            }
-            h_try = h_try.min(to_grid);
-        }
-        // A breakpoint closer than 1e-3 h_try ahead counts as reached (round-off: t, a sum
-        // of steps, is 2.4e-15 s short of 0.02 s after 10,240 steps of 1.953125e-6 s), and
-        // a step ending that close to one ends on it: never a sliver of a step, whose
-        // 1/(βh²) would swamp the iteration matrix and whose accelerations would be
-        // position round-off over βh². Straddling a kink by 1e-3 h errs by O(1e-3 h²)
-        // of the slope's jump, as the same rule at the end of the run.
-        let near = 1e-3 * h_try;
-        if let Some(b) = breaks.iter().find(|b| **b > t + near)
-            && t + h_try > *b - near
-        {
-            h_try = *b - t;
-        }
-        // Never leave a sliver of a step before the end (round-off in t would otherwise
-        // ask Newton for a step of 1e-11 s).
-        if end - (t + h_try) < 1e-3 * h_try {
-            h_try = end - t;
-        }
-        match integ.try_step(h_try) {
-            Ok(_) => {
-                integ.stats.min_step = integ.stats.min_step.min(h_try);
-                integ.stats.max_step = integ.stats.max_step.max(h_try);
-                let v = integ.constraint_violation();
-                integ.stats.max_constraint_violation = integ.stats.max_constraint_violation.max(v);
-                if let Err(f) = integ.check_removed_equations() {
-                    failure = Some(f);
-                }
-                integ.stats.cpu_seconds = cpu0 + start.elapsed().as_secs_f64();
-                integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
-                pause_due = true;
-                obs.state(&Snapshot {
-                    integ,
-                    step: integ.stats.steps,
-                    h: h_try,
-                })?;
-                obs.progress(integ.t, end, &integ.stats);
-                if integ.dynamic
-                    && drive_breaks.iter().any(|b| (integ.t - b).abs() <= near)
-                    && integ.consistent_accelerations().is_ok()
-                {
-                    integ.stats.restarts += 1;
-                }
-                good += 1;
-                if adaptive {
-                    // The local error estimate proposes the next step; it is taken from
-                    // a ladder h₀·2^(k/4), and grows only by two rungs or more, so that
-                    // runs of equal steps keep the factored matrix (modified Newton).
-                    h = ladder_step(h, integ.error_next, h0).clamp(hmin, hmax);
-                } else if h < h0 && good >= 4 {
-                    h = (2.0 * h).min(h0);
-                    good = 0;
-                }
-            }
-            Err(Failure {
-                reason: FailureReason::Aborted,
-                ..
-            }) => {
-                interrupted = Some(Interruption::WithinStep);
-                break;
-            }
-            Err(Failure {
-                reason: FailureReason::StepRefused(h_ok),
-                residual_history,
-                ..
-            }) => {
-                // An element (e.g. a contact at an impact) asks for a shorter step.
-                integ.recycle_history(residual_history);
-                integ.stats.rejected_steps += 1;
-                retry = Some(h_ok.max(hmin).min(h_try));
-            }
-            Err(f) => {
-                integ.stats.rejected_steps += 1;
-                good = 0;
-                h = h_try / 2.0;
-                if h < hmin * (1.0 - 1e-12) {
-                    failure = Some(f);
-                } else {
-                    integ.recycle_history(f.residual_history);
-                }
-            }
-        }
-    }
-    if integ.stats.min_step == f64::INFINITY {
-        integ.stats.min_step = 0.0;
-    }
-    integ.stats.cpu_seconds = cpu0 + start.elapsed().as_secs_f64();
-    integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
-    Ok(RunReport {
-        stats: integ.stats,
-        time: integ.t,
-        failure,
-        interrupted,
-    })
+    let mut stepper = Stepper::start(model, integ, obs, resume)?;
+    while stepper.step(integ, obs)? == StepOutcome::Accepted {}
+    Ok(stepper.finish(integ))
 }
 
 #[cfg(test)]

@@ -548,7 +548,7 @@ impl System {
         self.elements
             .iter()
             .enumerate()
-            .filter(|(_, el)| el.rheonomic())
+            .filter(|(_, el)| el.does_work())
             .map(|(e, el)| {
                 let o = self.mult_offset[e];
                 el.input_power(ctx, nodes, &lambda[o..o + el.multipliers()])

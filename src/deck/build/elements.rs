@@ -29,7 +29,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 14] = [
+        const TYPES: [&str; 15] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -42,6 +42,7 @@ impl Builder<'_> {
             "SPRING",
             "BUSHING",
             "RSPRING",
+            "PID",
             "PRESCRIBED",
             "CLEARANCE",
         ];
@@ -245,6 +246,7 @@ impl Builder<'_> {
             "SPRING" => self.spring_card(&mut c, id)?,
             "BUSHING" => Self::bushing_card(&mut c)?,
             "RSPRING" => self.rspring_card(&mut c, id)?,
+            "PID" => self.pid_card(&mut c, id)?,
             "PRESCRIBED" => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)

@@ -4,6 +4,7 @@
 mod analysis;
 mod checks;
 mod clearance;
+mod control;
 mod cursor;
 mod drives;
 mod elements;

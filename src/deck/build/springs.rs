@@ -200,12 +200,16 @@ impl Builder<'_> {
             match found {
                 Err(kind) => self.errors.push(DeckError::new(kind, span)),
                 Ok((nodes, axis)) => {
-                    if let Some(el) = self.elements.get_mut(&id)
-                        && let ElementKind::RSpring(d) = &mut el.kind
-                        && d.hinge.0 == hinge
-                    {
-                        d.axis = axis;
-                        el.nodes = nodes;
+                    if let Some(el) = self.elements.get_mut(&id) {
+                        match &mut el.kind {
+                            ElementKind::RSpring(d) if d.hinge.0 == hinge => {
+                                d.axis = axis;
+                                el.nodes = nodes;
+                            }
+                            // A PID's torque acts on its hinge's nodes (deck/build/control.rs).
+                            ElementKind::Control(_) => el.nodes = nodes,
+                            _ => {}
+                        }
                     }
                 }
             }

@@ -16,7 +16,7 @@ impl Integrator {
 
     /// The drivers' work over a trial step of size `h` (trapezoidal, as the loads'), J.
     fn driver_work(&self, h: f64, ctx: &EvalContext) -> f64 {
-        if !self.sys.elements.iter().any(|e| e.rheonomic()) {
+        if !self.sys.elements.iter().any(|e| e.does_work()) {
             return 0.0;
         }
         let ctx_old = EvalContext {
