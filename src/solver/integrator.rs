@@ -408,6 +408,23 @@ impl Integrator {
         ))
     }
 
+    /// Adds to the diagnosis of the failure that stops a run (not of every refused step:
+    /// the check costs a factorisation of the constraint rows) the constraint equations
+    /// that are nearly dependent at the failed attempt's last iterate, if any: a loop
+    /// reaching a singular position ([`crate::solver::redundancy::singular_position`]).
+    pub fn diagnose_constraints(&self, f: &mut Failure) {
+        if self.sys.n_eq() == self.sys.n_node_eq {
+            return;
+        }
+        if let Some(d) =
+            crate::solver::redundancy::singular_position(&self.sys, &self.trial, self.t + f.step)
+        {
+            let mut all = f.diagnoses.to_vec();
+            all.push(d);
+            f.diagnoses = all.into_boxed_slice();
+        }
+    }
+
     /// Largest constraint violation over all elements at the current state.
     pub fn constraint_violation(&self) -> f64 {
         self.sys

@@ -189,6 +189,12 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
 /// less than `1e-8` of the row's norm left after two passes of modified Gram–Schmidt.
 /// Rows already removed from `sys` count like the others.
 pub fn detect(sys: &System, nodes: &[NodeState], t: f64) -> Redundancy {
+    detect_with(sys, nodes, t, DEPENDENT)
+}
+
+/// [`detect`] with the threshold `tol`: a row is dependent when less than `tol` of its
+/// norm is left (`1e-3`: nearly dependent rows, as near a singular position).
+pub fn detect_with(sys: &System, nodes: &[NodeState], t: f64, tol: f64) -> Redundancy {
     let nn = sys.n_node_eq;
     let n = sys.n_eq();
     // Rows of every multiplier equation, by global equation.
@@ -255,7 +261,7 @@ pub fn detect(sys: &System, nodes: &[NodeState], t: f64) -> Redundancy {
                 }
             }
             let norm = row.iter().map(|v| v * v).sum::<f64>().sqrt();
-            if norm <= DEPENDENT * norm0 || norm0 == 0.0 {
+            if norm <= tol * norm0 || norm0 == 0.0 {
                 let (e, k) = owner[i];
                 out.removed.push(Redundant {
                     element: e,
@@ -422,6 +428,46 @@ impl Redundancy {
         }
         out
     }
+}
+
+/// The diagnosis of a run that failed near a singular position of its constraints: the
+/// equations (other than those removed at the start) that are dependent on the others to
+/// within `1e-3` of their norm at `nodes` (the failed step's last iterate), or `None`.
+pub fn singular_position(sys: &System, nodes: &[NodeState], t: f64) -> Option<String> {
+    near_dependent(sys, nodes, t, 1e-3).map(|list| {
+        format!(
+            "the constraints are nearly dependent here (a singular position: links aligned, a loop at its limit, where the joints block fewer motions than their equations, and the motion may not go on): {list}"
+        )
+    })
+}
+
+/// The equations dependent to within `tol`, not removed at the start, listed by element.
+fn near_dependent(sys: &System, nodes: &[NodeState], t: f64, tol: f64) -> Option<String> {
+    let r = detect_with(sys, nodes, t, tol);
+    let removed = sys.removed_equations();
+    let new: Vec<&Redundant> = r
+        .removed
+        .iter()
+        .filter(|x| !removed.contains(&x.global))
+        .collect();
+    if new.is_empty() {
+        return None;
+    }
+    let mut by_el: Vec<(ElementId, Vec<String>)> = Vec::new();
+    for x in &new {
+        let what = format!("{} ({})", x.equation + 1, x.motion);
+        match by_el.last_mut() {
+            Some((id, v)) if *id == x.id => v.push(what),
+            _ => by_el.push((x.id, vec![what])),
+        }
+    }
+    Some(
+        by_el
+            .iter()
+            .map(|(id, eqs)| format!("{id} (equation {})", eqs.join(", ")))
+            .collect::<Vec<_>>()
+            .join("; "),
+    )
 }
 
 /// The diagnosis of redundant constraints at a state where the iteration matrix could

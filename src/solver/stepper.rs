@@ -380,6 +380,8 @@ impl Stepper {
                 self.good = 0;
                 self.h = h_try / 2.0;
                 if self.h < hmin * (1.0 - 1e-12) {
+                    let mut f = f;
+                    integ.diagnose_constraints(&mut f);
                     self.failure = Some(f);
                 } else {
                     integ.recycle_history(f.residual_history);

@@ -489,3 +489,31 @@ fn contradicting_drivers_are_diagnosed() {
     assert!(matches!(f.reason, FailureReason::Constraints(_)), "{msg}");
     assert!(msg.contains("element 3"), "{msg}");
 }
+
+/// A loop driven into its singular position (a slider-crank whose rod, shorter than the
+/// crank, ends perpendicular to the slide at θ = asin(l/r)) is not silently jumped
+/// through: the run stops there, and its diagnosis names the equation that became
+/// dependent on the others (the slide's lateral guide).
+#[test]
+fn a_singular_position_of_a_loop_is_diagnosed() {
+    let text = std::fs::read_to_string(common::deck_path("slider_crank_hinges.dat"))
+        .unwrap()
+        .replace("r       0.05", "r       0.12")
+        .replace("l       0.12", "l       0.05")
+        .replace("theta0  3.141592653589793/6", "theta0  0");
+    let m = mecano::deck::parse_deck(&text, "locking.dat").expect("parses");
+    let rep = solver::run(&m, &mut mecano::output::History::new(1)).expect("runs");
+    let f = rep.failure.expect("the loop locks");
+    let lock = (0.05f64 / 0.12).asin() / 50.0;
+    let msg = f.to_string();
+    eprintln!("{msg}");
+    assert!(
+        (f.time - lock).abs() < 2e-3 * lock,
+        "stopped at {} s, lock at {lock} s",
+        f.time
+    );
+    assert!(
+        msg.contains("singular position") && msg.contains("element 6"),
+        "{msg}"
+    );
+}
