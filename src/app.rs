@@ -136,14 +136,10 @@ pub fn load_identified(
     set: &[(String, f64)],
     refine: u32,
 ) -> Result<(Model, DeckIdentity), u8> {
-    // A file beyond the deck size limit is not read whole: the loader refuses it.
-    let too_large =
-        std::fs::metadata(path).is_ok_and(|m| m.len() > deck::limits::MAX_DECK_BYTES as u64);
-    let text = match (!too_large).then(|| std::fs::read(path).map(String::from_utf8)) {
-        Some(Ok(Ok(t))) => t,
-        // Unreadable or not UTF-8: the loader says so, with its diagnostics.
-        _ => return Err(load_with(path, set).err().unwrap_or(EXIT_BAD_INPUT)),
-    };
+    let text = deck::read_source(path).map_err(|errs| {
+        eprintln!("{:?}", miette::Report::new(errs));
+        EXIT_BAD_INPUT
+    })?;
     let name = path.display().to_string();
     let mut model = deck::parse_deck_with(&text, &name, set).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
@@ -374,10 +370,7 @@ fn start_session(
     }
     // A checkpoint of an earlier run in this directory belongs to files just replaced.
     for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
-        match std::fs::remove_file(dir.join(name)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_err(e)),
-            _ => {}
-        }
+        crate::safe_file::remove_regular(&dir.join(name)).map_err(io_err)?;
     }
     let vtk = if model.output.vtk {
         Some(VtkWriter::create(dir, model, &integ.sys).map_err(io_err)?)
@@ -496,7 +489,7 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         } else {
             modes::About::Initial
         };
-        return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
+        return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet, opts.force);
     }
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);

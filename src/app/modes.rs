@@ -58,6 +58,10 @@ pub struct ModesArgs {
     /// No table on standard output.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Write into an output directory that holds files no mecano-rs run wrote there (they
+    /// are left as they are), as for runs.
+    #[arg(long)]
+    pub force: bool,
     /// Eigen-solver: `auto` (sparse from 300 unknowns: shift-invert Lanczos for a
     /// conservative model, Arnoldi on the first-order form for a damped or gyroscopic one;
     /// dense otherwise), `dense` or `sparse`.
@@ -313,6 +317,7 @@ pub fn run(args: &ModesArgs) -> u8 {
         count,
         &dir,
         args.quiet,
+        args.force,
         args.solver.into(),
     )
 }
@@ -327,10 +332,12 @@ pub fn run_loaded(
     count: usize,
     dir: &Path,
     quiet: bool,
+    force: bool,
 ) -> u8 {
-    run_loaded_using(deck, model, about, count, dir, quiet, Solver::Auto)
+    run_loaded_using(deck, model, about, count, dir, quiet, force, Solver::Auto)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_loaded_using(
     deck: &Path,
     model: &Model,
@@ -338,6 +345,7 @@ fn run_loaded_using(
     count: usize,
     dir: &Path,
     quiet: bool,
+    force: bool,
     solver: Solver,
 ) -> u8 {
     if about == About::Rotating
@@ -377,6 +385,15 @@ fn run_loaded_using(
             "point": [f.point.x, f.point.y, f.point.z],
         });
     }
+    // The directory is claimed as a run's is (app::outdir: its lock, the previous
+    // analysis's files replaced, foreign ones refused, nothing written through a link).
+    let _claim = match app::outdir::OutDir::claim_fresh(dir, &app::outdir::modes_files(), force) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {}: {e}", deck.display());
+            return EXIT_BAD_INPUT;
+        }
+    };
     let written = output::write_all(
         dir,
         &a,

@@ -197,8 +197,13 @@ fn run_fresh(
         reason: e.to_string(),
     })?;
     let overrides = plan.overrides(i);
-    let text = std::fs::read_to_string(&plan.deck).unwrap_or_default();
-    let result = match crate::deck::load_deck_with(&plan.deck, &overrides) {
+    // Read once (bounded: a regular file or a pipe): the text parsed is the text named.
+    let read = crate::deck::read_source(&plan.deck);
+    let text = read.as_deref().unwrap_or_default().to_string();
+    let parsed = read.and_then(|t| {
+        crate::deck::parse_deck_with(&t, &plan.deck.display().to_string(), &overrides)
+    });
+    let result = match parsed {
         Err(errs) => Err((app::EXIT_BAD_INPUT, deck_errors_text(&errs))),
         // `ANALYSIS MODES n`: the case is a modal analysis (its summary.json holds the
         // modes the `mode` quantities read), as `mecano-rs DECK` makes it.
@@ -209,7 +214,7 @@ fn run_fresh(
             } else {
                 app::modes::About::Initial
             };
-            match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true) {
+            match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true, false) {
                 app::EXIT_OK => Ok(crate::solver::RunReport {
                     stats: Default::default(),
                     time: 0.0,

@@ -11,6 +11,7 @@ mod energy_guard_run;
 mod large;
 mod modes_output;
 mod outdir;
+mod outdir_hostile;
 mod plot;
 mod restart;
 mod silent_wrong;

@@ -188,6 +188,13 @@ fn two_runs_started_together_one_runs_and_the_other_is_refused() {
         text(&a),
         text(&b)
     );
+    // The loser is told the directory is in use, never that it holds foreign files
+    // (the winner's, written under its manifest while the loser looked).
+    for o in [&a, &b] {
+        if o.status.code() == Some(2) {
+            assert!(text(o).contains("in use"), "{}", text(o));
+        }
+    }
     let rows = fs::read_to_string(out.join("node_12.csv")).unwrap();
     let times: Vec<f64> = rows
         .lines()
