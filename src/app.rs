@@ -72,6 +72,56 @@ impl RunOptions {
     }
 }
 
+/// The longest line a message of the command line echoes, characters.
+pub const ECHO_LINE_CHARS: usize = 200;
+
+/// `text` with every line longer than [`ECHO_LINE_CHARS`] cut there (with `…` and its
+/// length): no message grows with the input it quotes.
+pub fn cap_lines(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(64 << 10));
+    for line in text.split_inclusive('\n') {
+        match line.char_indices().nth(ECHO_LINE_CHARS) {
+            Some((i, _)) => {
+                out.push_str(&line[..i]);
+                out.push_str(&format!("… ({} characters)", line.chars().count()));
+                if line.ends_with('\n') {
+                    out.push('\n');
+                }
+            }
+            None => out.push_str(line),
+        }
+    }
+    out
+}
+
+/// clap's parser of `--set` ([`parse_set`]): its refusal says what is wrong, at which
+/// character, quoting at most a short prefix — not the whole argument, as clap's own
+/// message of an invalid value does.
+#[derive(Clone, Debug)]
+pub struct SetParser;
+
+impl clap::builder::TypedValueParser for SetParser {
+    type Value = (String, f64);
+
+    fn parse_ref(
+        &self,
+        _cmd: &clap::Command,
+        _arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<Self::Value, clap::Error> {
+        let refuse = |msg: String| {
+            clap::Error::raw(
+                clap::error::ErrorKind::ValueValidation,
+                format!("--set: {msg}\n"),
+            )
+        };
+        let s = value
+            .to_str()
+            .ok_or_else(|| refuse("the value is not UTF-8 text".into()))?;
+        parse_set(s).map_err(refuse)
+    }
+}
+
 /// Reads `name=value` (`--set`): a parameter name and a number or an expression of numbers
 /// (`E=2.1e11`, `h=1e-4/2`).
 pub fn parse_set(arg: &str) -> Result<(String, f64), String> {
@@ -114,28 +164,17 @@ pub fn load_refined(path: &Path, refine: u32) -> Result<Model, u8> {
 
 /// Parses a deck with parameter overrides (`--set`) and refines its mesh by `refine`.
 pub fn load_variant(path: &Path, set: &[(String, f64)], refine: u32) -> Result<Model, u8> {
-    let mut model = load_with(path, set)?;
-    apply_refine(path, &mut model, refine)?;
-    Ok(model)
+    load_source(path, set, refine).map(|(m, _)| m)
 }
 
-fn apply_refine(path: &Path, model: &mut Model, refine: u32) -> Result<(), u8> {
-    if refine > 1 {
-        model.refine(refine).map_err(|e| {
-            eprintln!("error: {}: --refine {refine}: {e}", path.display());
-            EXIT_BAD_INPUT
-        })?;
-    }
-    Ok(())
-}
-
-/// Parses a deck read once with the overrides `set`, refines it by `refine`, and names it:
-/// its path, the SHA-256 of the very text parsed, the overrides and the refinement (what a checkpoint is checked against).
-pub fn load_identified(
+/// Reads the deck once ([`deck::read_source`]: a regular file or a pipe, bounded), parses
+/// it with the overrides `set`, refines it by `refine`; the model and the very text parsed
+/// (what messages locate in, what a checkpoint names). Diagnostics printed on error.
+pub fn load_source(
     path: &Path,
     set: &[(String, f64)],
     refine: u32,
-) -> Result<(Model, DeckIdentity), u8> {
+) -> Result<(Model, String), u8> {
     let text = deck::read_source(path).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
@@ -146,6 +185,39 @@ pub fn load_identified(
         EXIT_BAD_INPUT
     })?;
     apply_refine(path, &mut model, refine)?;
+    Ok((model, text))
+}
+
+/// `path:line:col` of the byte `span.start` of the deck text `text` read from `path`.
+pub fn locate(path: &Path, text: &str, span: crate::model::Span) -> String {
+    let (line, col) = deck::line_col(text, span.start);
+    format!("{}:{line}:{col}", path.display())
+}
+
+/// Refines the model by `refine` (0 or 1: as written), then checks that the whole of it —
+/// nodes, elements, the unknowns' system, the output's buffers — fits in the memory the
+/// process may take (`--max-memory`, else what is available: [`crate::model::budget`]).
+fn apply_refine(path: &Path, model: &mut Model, refine: u32) -> Result<(), u8> {
+    if refine > 1 {
+        model.refine(refine).map_err(|e| {
+            eprintln!("error: {}: --refine {refine}: {e}", path.display());
+            EXIT_BAD_INPUT
+        })?;
+    }
+    crate::model::budget::check(model.footprint(), "the model").map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        EXIT_BAD_INPUT
+    })
+}
+
+/// Parses a deck read once with the overrides `set`, refines it by `refine`, and names it:
+/// its path, the SHA-256 of the very text parsed, the overrides and the refinement (what a checkpoint is checked against).
+pub fn load_identified(
+    path: &Path,
+    set: &[(String, f64)],
+    refine: u32,
+) -> Result<(Model, DeckIdentity), u8> {
+    let (model, text) = load_source(path, set, refine)?;
     let id = deck_identity(path, &text, set, refine);
     Ok((model, id))
 }
@@ -473,10 +545,11 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let (model, id) = match load_identified(path, &opts.set, opts.refine) {
+    let (model, text) = match load_source(path, &opts.set, opts.refine) {
         Ok(m) => m,
         Err(code) => return code,
     };
+    let id = deck_identity(path, &text, &opts.set, opts.refine);
     let dir = opts
         .out_dir
         .clone()
@@ -489,7 +562,16 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         } else {
             modes::About::Initial
         };
-        return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet, opts.force);
+        return modes::run_loaded(
+            path,
+            &text,
+            &model,
+            about,
+            n as usize,
+            &dir,
+            opts.quiet,
+            opts.force,
+        );
     }
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);

@@ -56,6 +56,12 @@ pub fn parse_deck_with(
         .map_err(|errors| DeckErrors::new(source, file_name, errors))
 }
 
+/// The 1-based line and column (in characters) of the byte `offset` of `text`: where a
+/// message that is not a [`DeckError`] points (`file:line:col`).
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    error::line_col(text, offset)
+}
+
 /// Whether `name` is a valid parameter name (a letter or `_`, then letters, digits, `_`).
 pub fn is_parameter_name(name: &str) -> bool {
     expr::is_name(name)
@@ -102,6 +108,7 @@ pub fn load_deck_with(path: &Path, overrides: &[(String, f64)]) -> Result<Model,
 /// texts).
 pub fn strip_spans(model: &mut Model) {
     let zero = Span::default();
+    model.modes_span = zero;
     model.nodes.values_mut().for_each(|x| x.span = zero);
     model.materials.values_mut().for_each(|x| x.span = zero);
     model.sections.values_mut().for_each(|x| x.span = zero);

@@ -7,6 +7,7 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+pub mod budget;
 mod clearance;
 mod drive;
 mod expr;
@@ -427,6 +428,10 @@ pub struct Model {
     /// hub driven at constant speed, seen in the rotating frame (as `mecano-rs modes
     /// --rotating`; [`crate::modes::rotating`]).
     pub modes_rotating: bool,
+    /// Where the deck asks for the modes: the span of its `ANALYSIS MODES n` card (the
+    /// default span when it does not), so that a refusal of the count or of the rotating
+    /// state points at it.
+    pub modes_span: Span,
     /// Output requests.
     pub output: OutputRequest,
     /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the

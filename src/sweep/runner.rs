@@ -214,7 +214,7 @@ fn run_fresh(
             } else {
                 app::modes::About::Initial
             };
-            match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true, false) {
+            match app::modes::run_loaded(&plan.deck, &text, &model, about, n, dir, true, false) {
                 app::EXIT_OK => Ok(crate::solver::RunReport {
                     stats: Default::default(),
                     time: 0.0,

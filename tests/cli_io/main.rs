@@ -13,6 +13,8 @@ mod modes_output;
 mod outdir;
 mod outdir_hostile;
 mod plot;
+mod refusals;
+mod resources;
 mod restart;
 mod silent_wrong;
 mod sweep;

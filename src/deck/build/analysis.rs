@@ -129,6 +129,7 @@ impl Builder<'_> {
             self.set_analysis(analysis, span)?;
             self.modes = Some(n);
             self.modes_rotating = rotating;
+            self.modes_span = span;
             return Ok(());
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
