@@ -170,11 +170,7 @@ pub fn load_variant(path: &Path, set: &[(String, f64)], refine: u32) -> Result<M
 /// Reads the deck once ([`deck::read_source`]: a regular file or a pipe, bounded), parses
 /// it with the overrides `set`, refines it by `refine`; the model and the very text parsed
 /// (what messages locate in, what a checkpoint names). Diagnostics printed on error.
-pub fn load_source(
-    path: &Path,
-    set: &[(String, f64)],
-    refine: u32,
-) -> Result<(Model, String), u8> {
+pub fn load_source(path: &Path, set: &[(String, f64)], refine: u32) -> Result<(Model, String), u8> {
     let text = deck::read_source(path).map_err(|errs| {
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
@@ -563,14 +559,7 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
             modes::About::Initial
         };
         return modes::run_loaded(
-            path,
-            &text,
-            &model,
-            about,
-            n as usize,
-            &dir,
-            opts.quiet,
-            opts.force,
+            path, &text, &model, about, n as usize, &dir, opts.quiet, opts.force,
         );
     }
     let what = path.display().to_string();

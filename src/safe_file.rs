@@ -187,7 +187,8 @@ mod tests {
     use std::os::unix::fs::symlink;
 
     fn scratch(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("mecano_safe_file_{name}_{}", std::process::id()));
+        let d =
+            std::env::temp_dir().join(format!("mecano_safe_file_{name}_{}", std::process::id()));
         let _ = fs::remove_dir_all(&d);
         fs::create_dir_all(&d).unwrap();
         d

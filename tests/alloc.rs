@@ -253,7 +253,11 @@ fn a_refused_model_never_allocates_100_mb() {
     let generated = "NODES\n  1 TO 1000000 LINE 0 0 0 1 0 0\n  1000001 TO 2000000 LINE 0 0 0 1 0 0\nANALYSIS STATIC STEPS 1\n";
     let beams = "MATERIALS\n 1 E 2e11 NU 0.3 RHO 7800\nSECTIONS\n 1 A 1e-4 I2 1e-9 I3 1e-9 J 2e-9\nNODES\n 1 0 0 0\n 2 1 0 0\nELEMENTS\n 1 BEAM 1 2 MAT 1 SEC 1 DIVIDE 1000000\nANALYSIS STATIC STEPS 1\n";
     const BOUND: usize = 100_000_000;
-    for (name, text) in [("DIVIDE", divided.as_str()), ("TO", generated), ("one beam", beams)] {
+    for (name, text) in [
+        ("DIVIDE", divided.as_str()),
+        ("TO", generated),
+        ("one beam", beams),
+    ] {
         let (r, largest) = largest_allocation_in(|| mecano::deck::parse_deck(text, "big.dat"));
         let e = r.expect_err(name);
         assert!(e.to_string().contains("--max-memory"), "{name}: {e}");
@@ -263,6 +267,9 @@ fn a_refused_model_never_allocates_100_mb() {
     let (r, largest) = largest_allocation_in(|| model.refine(1_000_000));
     let e = r.expect_err("--refine 1000000");
     assert!(e.to_string().contains("--max-memory"), "{e}");
-    assert!(largest < BOUND, "--refine: an allocation of {largest} bytes");
+    assert!(
+        largest < BOUND,
+        "--refine: an allocation of {largest} bytes"
+    );
     mecano::model::budget::set_max_memory(0);
 }

@@ -124,7 +124,10 @@ pub fn read_text(path: &Path) -> io::Result<String> {
         ),
         ReadError::Silent(w) => io::Error::new(
             io::ErrorKind::TimedOut,
-            format!("it is a pipe from which nothing came within {} s", w.as_secs()),
+            format!(
+                "it is a pipe from which nothing came within {} s",
+                w.as_secs()
+            ),
         ),
     })?;
     if bytes.len() > MAX_DECK_BYTES {
@@ -225,9 +228,16 @@ mod tests {
     /// A device, a directory: refused without reading (`/dev/zero` would never end).
     #[test]
     fn devices_and_directories_are_refused_unread() {
-        for (p, says) in [("/dev/zero", "a device"), ("/dev/null", "a device"), ("/", "a directory")] {
+        for (p, says) in [
+            ("/dev/zero", "a device"),
+            ("/dev/null", "a device"),
+            ("/", "a directory"),
+        ] {
             let e = message(read_source(Path::new(p)).unwrap_err());
-            assert!(e.contains(says) && e.contains("regular file or a pipe"), "{p}: {e}");
+            assert!(
+                e.contains(says) && e.contains("regular file or a pipe"),
+                "{p}: {e}"
+            );
         }
     }
 

@@ -195,7 +195,7 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
         .parse()
         .map_err(|_| format!("`{t}` is not a size (e.g. 512M, 2G)"))?;
     let bytes = v * mult as f64;
-    if !(bytes.is_finite() && bytes >= 1.0 && bytes < 1.8e19) {
+    if !(1.0..1.8e19).contains(&bytes) {
         return Err(format!("`{t}`: a size from 1 byte to 16 EiB"));
     }
     Ok(bytes as u64)

@@ -232,10 +232,14 @@ impl Model {
         let count = params.len();
         let mut ids = Vec::new();
         ids.try_reserve_exact(count).map_err(|_| oom_nodes(count))?;
-        self.nodes.try_reserve(count).map_err(|_| oom_nodes(count))?;
+        self.nodes
+            .try_reserve(count)
+            .map_err(|_| oom_nodes(count))?;
         let moving = ia.is_some() || ib.is_some();
         if moving {
-            self.initial.try_reserve(count).map_err(|_| oom_nodes(count))?;
+            self.initial
+                .try_reserve(count)
+                .map_err(|_| oom_nodes(count))?;
         }
         // x(s) = x_a + s (x_b − x_a), as [`axis_points`], one node at a time (no list of
         // points beside the nodes themselves).

@@ -74,13 +74,13 @@ impl Model {
             let (a, b, span) = (el.nodes[0], el.nodes[1], el.span);
             // The span of this element on its user beam's arc: [k/n, (k+1)/n] for
             // sub-element k of a beam divided in n, [0, 1] otherwise.
-            let (user, range) = place.get(&id).map_or(
-                ((id, [a, b]), (0.0, 1.0)),
-                |&(u, ends, k, n)| {
-                    let n = n as f64;
-                    ((u, ends), (k as f64 / n, (k + 1) as f64 / n))
-                },
-            );
+            let (user, range) =
+                place
+                    .get(&id)
+                    .map_or(((id, [a, b]), (0.0, 1.0)), |&(u, ends, k, n)| {
+                        let n = n as f64;
+                        ((u, ends), (k as f64 / n, (k + 1) as f64 / n))
+                    });
             let params = gll_params(order);
             let interior =
                 self.add_axis_nodes_indexed(a, b, &params, numbering, span, &mut index)?;

@@ -130,7 +130,11 @@ fn expect(s: &Scene, deck: &Path, extra: &[&str], code: i32, says: &str) -> Outp
     let before = s.sums();
     let o = run(deck, &s.out(), extra);
     assert_eq!(o.status.code(), Some(code), "{}", text(&o));
-    assert!(text(&o).contains(says), "expected `{says}` in: {}", text(&o));
+    assert!(
+        text(&o).contains(says),
+        "expected `{says}` in: {}",
+        text(&o)
+    );
     assert_eq!(s.sums(), before, "the decoy tree changed: {}", text(&o));
     o
 }
@@ -168,11 +172,17 @@ fn a_foreign_file_named_like_a_history_is_left_alone_with_force() {
     expect(&s, &s.deck, &[], 2, "node_2.csv");
     let o = expect(&s, &s.deck, &["--force"], 2, "no mecano-rs run wrote");
     assert!(text(&o).contains("node_2.csv"), "{}", text(&o));
-    assert_eq!(fs::read_to_string(out.join("node_2.csv")).unwrap(), "my notes");
+    assert_eq!(
+        fs::read_to_string(out.join("node_2.csv")).unwrap(),
+        "my notes"
+    );
     // A foreign file the run does not write: --force runs beside it and leaves it.
     fs::rename(out.join("node_2.csv"), out.join("notes.txt")).unwrap();
     expect(&s, &s.deck, &["--force"], 0, "");
-    assert_eq!(fs::read_to_string(out.join("notes.txt")).unwrap(), "my notes");
+    assert_eq!(
+        fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "my notes"
+    );
     assert!(out.join("node_2.csv").is_file());
 }
 
@@ -195,7 +205,10 @@ fn a_hostile_manifest_removes_nothing_outside_the_directory_nor_in_a_subdirector
     // Every top-level name is listed (the manifest's), so the run goes on: it removes
     // none of them (links and a directory), and nothing through them.
     expect(&s, &s.deck, &[], 0, "");
-    assert_eq!(fs::read_to_string(out.join("real/inner.txt")).unwrap(), "mine");
+    assert_eq!(
+        fs::read_to_string(out.join("real/inner.txt")).unwrap(),
+        "mine"
+    );
     assert!(fs::symlink_metadata(out.join("sub")).is_ok());
     assert!(fs::symlink_metadata(out.join("leaf")).is_ok());
     // The run's own manifest lists plain names of its files only.
@@ -204,7 +217,10 @@ fn a_hostile_manifest_removes_nothing_outside_the_directory_nor_in_a_subdirector
     // A second run removes the first's files and still nothing else (the links are
     // foreign now: --force).
     expect(&s, &s.deck, &["--force"], 0, "");
-    assert_eq!(fs::read_to_string(out.join("real/inner.txt")).unwrap(), "mine");
+    assert_eq!(
+        fs::read_to_string(out.join("real/inner.txt")).unwrap(),
+        "mine"
+    );
 }
 
 #[test]
@@ -233,7 +249,11 @@ fn a_lock_or_manifest_that_is_a_link_is_refused_and_nothing_is_created_where_it_
     expect(&s, &s.deck, &["--force"], 2, "symbolic link");
     fs::remove_file(out.join(".mecano-manifest")).unwrap();
     // The manifest's temporary name a link: refused, not written through.
-    symlink(s.decoy().join("victim.txt"), out.join(".mecano-manifest.tmp")).unwrap();
+    symlink(
+        s.decoy().join("victim.txt"),
+        out.join(".mecano-manifest.tmp"),
+    )
+    .unwrap();
     expect(&s, &s.deck, &[], 2, "symbolic link");
 }
 
@@ -248,7 +268,13 @@ fn a_vtk_name_that_is_a_link_or_a_foreign_directory_is_refused() {
     // replace.
     fs::create_dir_all(out.join("vtk")).unwrap();
     fs::write(out.join("vtk/frame_000000.vtu"), "theirs").unwrap();
-    expect(&s, &s.vtk_deck, &[], 2, "vtk/ is a directory no mecano-rs run wrote");
+    expect(
+        &s,
+        &s.vtk_deck,
+        &[],
+        2,
+        "vtk/ is a directory no mecano-rs run wrote",
+    );
     assert_eq!(
         fs::read_to_string(out.join("vtk/frame_000000.vtu")).unwrap(),
         "theirs"
@@ -260,7 +286,11 @@ fn a_vtk_name_that_is_a_link_or_a_foreign_directory_is_refused() {
     assert!(out.join("vtk/frame_000000.vtu").is_file());
     expect(&s, &s.vtk_deck, &[], 0, "");
     fs::remove_file(out.join("vtk/frame_000001.vtu")).unwrap();
-    symlink(s.decoy().join("victim.txt"), out.join("vtk/frame_000001.vtu")).unwrap();
+    symlink(
+        s.decoy().join("victim.txt"),
+        out.join("vtk/frame_000001.vtu"),
+    )
+    .unwrap();
     expect(&s, &s.vtk_deck, &[], 2, "not a regular file");
 }
 

@@ -25,7 +25,11 @@ fn text(o: &Output) -> String {
 }
 
 fn run(args: &[&str], paths: &[&Path]) -> Output {
-    bin().args(args).args(paths).output().expect("the binary runs")
+    bin()
+        .args(args)
+        .args(paths)
+        .output()
+        .expect("the binary runs")
 }
 
 fn rotating(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
@@ -50,7 +54,12 @@ fn line_of(p: &Path, needle: &str) -> usize {
 fn modal_refusals_point_at_the_deck_card_or_the_option() {
     let d = common::TempDir::new("refusals_modes");
     // A mode count of 2³² − 1 in the deck: at its ANALYSIS card, by a run and by modes.
-    let big = rotating(&d, "big.dat", "ANALYSIS MODES 10 ROTATING", "ANALYSIS MODES 4294967295 ROTATING");
+    let big = rotating(
+        &d,
+        "big.dat",
+        "ANALYSIS MODES 10 ROTATING",
+        "ANALYSIS MODES 4294967295 ROTATING",
+    );
     let line = line_of(&big, "ANALYSIS MODES 4294967295");
     for args in [vec!["-q", "-o"], vec!["modes", "-q", "-o"]] {
         let o = run(&args, &[&d.join("o1"), &big]);
@@ -74,7 +83,9 @@ fn modal_refusals_point_at_the_deck_card_or_the_option() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     let line = line_of(&undriven, "ANALYSIS MODES 10");
     assert!(
-        text(&o).contains(&format!("undriven.dat:{line}:1: ANALYSIS MODES … ROTATING: no driven HINGE")),
+        text(&o).contains(&format!(
+            "undriven.dat:{line}:1: ANALYSIS MODES … ROTATING: no driven HINGE"
+        )),
         "{}",
         text(&o)
     );
@@ -84,7 +95,8 @@ fn modal_refusals_point_at_the_deck_card_or_the_option() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     let line = line_of(&loose, "HINGE 1 2");
     assert!(
-        text(&o).contains(&format!("loose.dat:{line}:")) && text(&o).contains(": element 1: the driven hinge"),
+        text(&o).contains(&format!("loose.dat:{line}:"))
+            && text(&o).contains(": element 1: the driven hinge"),
         "{}",
         text(&o)
     );
@@ -94,16 +106,27 @@ fn modal_refusals_point_at_the_deck_card_or_the_option() {
         let mut args = vec!["modes", "-q"];
         args.extend(&opt);
         args.push("-o");
-        let o = run(&args, &[&d.join("o5"), &common::deck_path("rotating_cantilever.dat")]);
+        let o = run(
+            &args,
+            &[&d.join("o5"), &common::deck_path("rotating_cantilever.dat")],
+        );
         assert_eq!(o.status.code(), Some(2), "{opt:?}: {}", text(&o));
-        assert!(text(&o).contains(opt[0]) && text(&o).contains("ROTATING"), "{}", text(&o));
+        assert!(
+            text(&o).contains(opt[0]) && text(&o).contains("ROTATING"),
+            "{}",
+            text(&o)
+        );
         assert!(!d.join("o5").exists(), "nothing written");
     }
     // A node held in the inertial frame besides the ground: named once.
     let held = rotating(&d, "held.dat", "3  1 0 0", "3  1 0 0  FIX X");
     let o = run(&["-q", "-o"], &[&d.join("o6"), &held]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("node 3 has fixed degrees"), "{}", text(&o));
+    assert!(
+        text(&o).contains("node 3 has fixed degrees"),
+        "{}",
+        text(&o)
+    );
     assert!(!text(&o).contains("node node"), "{}", text(&o));
 }
 
@@ -112,19 +135,50 @@ fn echoes_of_the_command_line_are_bounded_and_100_levels_are_accepted() {
     let deck = common::deck_path("pendulum_sweep.dat");
     let nest = |k: usize| format!("E={}2.1e11{}", "(".repeat(k), ")".repeat(k));
     // 60,000 levels: refused, the message a few hundred bytes (it was 120 kB).
-    let o = bin().arg("--check").arg(&deck).arg("--set").arg(nest(60_000)).output().unwrap();
+    let o = bin()
+        .arg("--check")
+        .arg(&deck)
+        .arg("--set")
+        .arg(nest(60_000))
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).len() < 1000, "{} bytes: {}", text(&o).len(), text(&o));
+    assert!(
+        text(&o).len() < 1000,
+        "{} bytes: {}",
+        text(&o).len(),
+        text(&o)
+    );
     assert!(text(&o).contains("nested too deeply"), "{}", text(&o));
     // grammar.md: 100 levels of parentheses; 101 refused.
-    let o = bin().arg("--check").arg(&deck).arg("--set").arg(nest(100)).output().unwrap();
+    let o = bin()
+        .arg("--check")
+        .arg(&deck)
+        .arg("--set")
+        .arg(nest(100))
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    assert!(text(&o).contains("E = 210000000000.0   (--set)"), "{}", text(&o));
-    let o = bin().arg("--check").arg(&deck).arg("--set").arg(nest(101)).output().unwrap();
+    assert!(
+        text(&o).contains("E = 210000000000.0   (--set)"),
+        "{}",
+        text(&o)
+    );
+    let o = bin()
+        .arg("--check")
+        .arg(&deck)
+        .arg("--set")
+        .arg(nest(101))
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     // Any other argument clap refuses: its echo is cut per line.
     let huge = "9".repeat(100_000);
-    let o = bin().args(["--check", "--refine", &huge]).arg(&deck).output().unwrap();
+    let o = bin()
+        .args(["--check", "--refine", &huge])
+        .arg(&deck)
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).len() < 1000, "{} bytes", text(&o).len());
 }
@@ -136,12 +190,24 @@ fn sweep_refuses_an_unusable_output_path_and_zero_jobs_with_exit_2() {
     let file = d.join("a_file");
     fs::write(&file, "x").unwrap();
     for out in [file.clone(), file.join("sub"), PathBuf::from("/dev/null")] {
-        let o = bin().arg("sweep").arg(&plan).arg("-o").arg(&out).output().unwrap();
+        let o = bin()
+            .arg("sweep")
+            .arg(&plan)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
         assert_eq!(o.status.code(), Some(2), "{}: {}", out.display(), text(&o));
         assert!(text(&o).contains("not a directory"), "{}", text(&o));
     }
     assert_eq!(fs::read_to_string(&file).unwrap(), "x");
-    let o = bin().arg("sweep").arg(&plan).args(["--jobs", "0", "-o"]).arg(d.join("s")).output().unwrap();
+    let o = bin()
+        .arg("sweep")
+        .arg(&plan)
+        .args(["--jobs", "0", "-o"])
+        .arg(d.join("s"))
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(!d.join("s").exists());
 }

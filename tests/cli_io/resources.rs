@@ -96,8 +96,20 @@ fn values_whose_scale_overflows_are_refused_as_input_located() {
         variant(&d, "spring.dat", &spring, "k 800", "k 1e308"),
         variant(&d, "ea.dat", &rotating, "EA 1e7", "EA 1e308"),
         variant(&d, "coord.dat", &pendulum, "24  0 -1.8 0", "24  0 -1e308 0"),
-        variant(&d, "gravity.dat", &pendulum, "GRAVITY 0 -9.81 0", "GRAVITY 0 -1e308 0"),
-        variant(&d, "moment.dat", &pendulum, "0 0 -1000  FUNCTION 1", "0 0 -1e308  FUNCTION 1"),
+        variant(
+            &d,
+            "gravity.dat",
+            &pendulum,
+            "GRAVITY 0 -9.81 0",
+            "GRAVITY 0 -1e308 0",
+        ),
+        variant(
+            &d,
+            "moment.dat",
+            &pendulum,
+            "0 0 -1000  FUNCTION 1",
+            "0 0 -1e308  FUNCTION 1",
+        ),
         variant(
             &d,
             "sine.dat",
@@ -170,7 +182,9 @@ fn a_model_beyond_max_memory_is_refused_with_its_figure() {
         let t = text(&o);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
         assert!(
-            t.contains("DIVIDE 1000000") && t.contains("GB") && t.contains("1.074 GB of --max-memory"),
+            t.contains("DIVIDE 1000000")
+                && t.contains("GB")
+                && t.contains("1.074 GB of --max-memory"),
             "{args:?}: {t}"
         );
         assert!(t.contains("divided.dat:34:3"), "{args:?}: {t}");
@@ -213,7 +227,9 @@ fn running_out_of_address_space_is_an_error_not_an_abort() {
         } else {
             common::deck_path("pendulum.dat")
         };
-        c.args(["--check", "--max-memory", "1000T"]).args(&extra).arg(src);
+        c.args(["--check", "--max-memory", "1000T"])
+            .args(&extra)
+            .arg(src);
         // SAFETY: setrlimit(2) between fork and exec touches no memory of the parent.
         unsafe {
             use std::os::unix::process::CommandExt;
@@ -239,7 +255,11 @@ fn running_out_of_address_space_is_an_error_not_an_abort() {
 /// until the kernel killed the process, 25 GB).
 #[test]
 fn a_deck_path_that_is_not_a_file_or_a_pipe_is_refused() {
-    for (p, says) in [("/dev/zero", "a device"), ("/dev/urandom", "a device"), ("/", "a directory")] {
+    for (p, says) in [
+        ("/dev/zero", "a device"),
+        ("/dev/urandom", "a device"),
+        ("/", "a directory"),
+    ] {
         for check in [true, false] {
             let mut c = bin();
             if check {

@@ -55,7 +55,11 @@ fn cases() -> Vec<Case> {
                     plants.push((w.next().unwrap().into(), w.next().unwrap().into()));
                 }
             }
-            assert!(!expect.is_empty(), "{}: no `! expect:` line", path.display());
+            assert!(
+                !expect.is_empty(),
+                "{}: no `! expect:` line",
+                path.display()
+            );
             Case {
                 path,
                 args,
@@ -119,7 +123,12 @@ fn the_fuzzers_cases_end_as_expected_and_touch_nothing_outside() {
     let all = cases();
     assert!(all.len() >= 10, "{} cases", all.len());
     for case in &all {
-        let name = case.path.file_name().unwrap().to_string_lossy().into_owned();
+        let name = case
+            .path
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
         let sandbox = common::TempDir::new(&format!("fuzz_{}", name.trim_end_matches(".dat")));
         fs::copy(&case.path, sandbox.join("deck.dat")).unwrap();
         let decoy = sandbox.join("decoy");
@@ -170,6 +179,9 @@ fn the_fuzzers_cases_end_as_expected_and_touch_nothing_outside() {
             .collect();
         entries.sort();
         entries.retain(|e| !["deck.dat", "decoy", "out"].contains(&e.as_str()));
-        assert!(entries.is_empty(), "{name}: written beside out/: {entries:?}");
+        assert!(
+            entries.is_empty(),
+            "{name}: written beside out/: {entries:?}"
+        );
     }
 }

@@ -98,7 +98,10 @@ fn deep_nesting_is_a_located_error() {
     for (open, close) in [("(", ")"), ("sqrt(", ")"), ("-", "")] {
         let nest = |k: usize| format!("{}4{}", open.repeat(k), close.repeat(k));
         assert!(ev(&nest(MAX_DEPTH)).is_ok(), "{open}");
-        assert_eq!(ev(&nest(MAX_DEPTH + 1)).unwrap_err().kind, ExprErrorKind::TooDeep);
+        assert_eq!(
+            ev(&nest(MAX_DEPTH + 1)).unwrap_err().kind,
+            ExprErrorKind::TooDeep
+        );
     }
     let ok = vec!["1"; MAX_DEPTH + 1].join("^");
     assert_eq!(ev(&ok), Ok(1.0));
