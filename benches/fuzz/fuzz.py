@@ -620,9 +620,13 @@ def run_case(binary, root, seed, k, limit):
     foreign = sorted(parent_after - parent_before - {os.path.basename(sandbox)})
     # Other workers' sandboxes appear in the parent: only entries not named like a case.
     foreign = [f for f in foreign if not f.startswith("c")]
-    nonfinite, summary = scan_outputs(os.path.join(sandbox, "out"))
+    # The run's directory: -o out, else the default out/<deck name> (modes: …/modes).
+    run_dir = os.path.join(sandbox, "out")
+    if "-o" not in args:
+        run_dir = os.path.join(run_dir, "deck", "modes" if mode == "modes" else "")
+    nonfinite, summary = scan_outputs(run_dir)
     energy_scale = 0.0
-    ecsv = os.path.join(sandbox, "out", "energy.csv")
+    ecsv = os.path.join(run_dir, "energy.csv")
     if os.path.isfile(ecsv) and not os.path.islink(ecsv):
         try:
             with open(ecsv) as f:
