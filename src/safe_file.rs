@@ -111,6 +111,40 @@ pub fn open_read(path: &Path) -> io::Result<File> {
     open_guarded(path, OpenOptions::new().read(true))
 }
 
+/// Opens `path` for reading as a reader of a run's files does (`compare`, `plot`, `resume`,
+/// a sweep's collection): links are followed (a directory of runs may be a user's links),
+/// but what is opened must be a regular file — a FIFO or a device under a history's name
+/// is refused at once, never waited on or read without end.
+pub fn open_regular(path: &Path) -> io::Result<File> {
+    let f = OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_CLOEXEC)
+        .open(path)
+        .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+    let ft = f.metadata()?.file_type();
+    if !ft.is_file() {
+        return Err(not_regular(path, kind_of(&ft)));
+    }
+    Ok(f)
+}
+
+/// [`open_regular`], read whole as UTF-8 text, refusing more than `max` bytes.
+pub fn read_text(path: &Path, max: u64) -> io::Result<String> {
+    let mut bytes = Vec::new();
+    open_regular(path)?.take(max + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("{} is longer than {max} bytes: refused", path.display()),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))
+}
+
+/// The largest JSON or text file a reader of a run's directory takes whole (a summary
+/// with its step-resolution table is a few kB; a sweep's statistics a few MB).
+pub const MAX_TEXT_BYTES: u64 = 256 << 20;
+
 /// Reads the regular file `path` whole, refusing one longer than `max` bytes (at most
 /// `max + 1` bytes are read).
 pub fn read_bounded(path: &Path, max: u64) -> io::Result<Vec<u8>> {

@@ -317,7 +317,11 @@ pub fn run(args: &SweepArgs) -> u8 {
                 let _ = write!(
                     out,
                     "{}",
-                    std::fs::read_to_string(plan.out.join("statistics.csv")).unwrap_or_default()
+                    crate::safe_file::read_text(
+                        &plan.out.join("statistics.csv"),
+                        crate::safe_file::MAX_TEXT_BYTES
+                    )
+                    .unwrap_or_default()
                 );
             }
             // Issue 28 §5: a sweep whose cases failed (or whose quantities are missing)

@@ -79,7 +79,9 @@ pub struct CaseRecord {
 /// the case's files (no rerun) and the record rewritten.
 pub fn finished(plan: &Plan, i: usize) -> Option<CaseRecord> {
     let dir = plan.case_dir(i);
-    let text = std::fs::read_to_string(dir.join("case.json")).ok()?;
+    let text =
+        crate::safe_file::read_text(&dir.join("case.json"), crate::safe_file::MAX_TEXT_BYTES)
+            .ok()?;
     let mut rec: CaseRecord = serde_json::from_str(&text).ok()?;
     if rec.values != plan.cases[i] || rec.deck_hash != plan.deck_hash {
         return None;
@@ -106,10 +108,11 @@ fn quantify(plan: &Plan, dir: &Path, rec: &mut CaseRecord) {
     if !matches!(rec.status, Status::Ok | Status::Failed) {
         return;
     }
-    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or_default();
+    let summary: serde_json::Value =
+        crate::safe_file::read_text(&dir.join("summary.json"), crate::safe_file::MAX_TEXT_BYTES)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default();
     for (k, q) in plan.quantities.iter().enumerate() {
         match q.eval(dir, &summary) {
             Ok(v) => rec.quantities[k] = v,

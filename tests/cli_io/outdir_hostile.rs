@@ -317,3 +317,37 @@ fn a_checkpoint_that_is_a_link_is_not_read_by_resume() {
     assert!(text(&o).contains("symbolic link"), "{}", text(&o));
     assert_eq!(s.sums(), before);
 }
+
+/// A FIFO planted under a run's file name is never waited on by the programs that read a
+/// run's directory: `resume` (its summary.json; the fuzzer's case 35:6932 waited for a
+/// writer for ever, deaf to Ctrl-C) and `compare` (a history) refuse it at once, exit 2.
+#[test]
+fn a_fifo_under_a_runs_file_name_is_refused_by_its_readers() {
+    let s = Scene::new("fifo_read");
+    let out = s.out();
+    expect(&s, &s.deck, &[], 0, "");
+    let reference = s.root.join("reference");
+    fs::create_dir_all(&reference).unwrap();
+    for f in ["node_2.csv", "summary.json"] {
+        fs::copy(out.join(f), reference.join(f)).unwrap();
+    }
+    let mkfifo = |p: &Path| {
+        let _ = fs::remove_file(p);
+        let c = std::ffi::CString::new(p.as_os_str().as_encoded_bytes()).unwrap();
+        // SAFETY: mkfifo(3) on a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    };
+    mkfifo(&out.join("summary.json"));
+    let mut c = bin();
+    c.arg("resume").arg(&out);
+    let o = crate::resources::within(c, std::time::Duration::from_secs(120));
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    mkfifo(&out.join("node_2.csv"));
+    let mut c = bin();
+    c.arg("compare")
+        .arg(&out)
+        .arg(&reference)
+        .args(["--nodes", "2"]);
+    let o = crate::resources::within(c, std::time::Duration::from_secs(120));
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}

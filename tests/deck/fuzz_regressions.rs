@@ -140,9 +140,11 @@ fn the_fuzzers_cases_end_as_expected_and_touch_nothing_outside() {
         }
         let before = checksums(&decoy);
         let mut args: Vec<String> = case.args.clone();
-        // `modes` comes before the deck; everything else after it.
-        let at = usize::from(args.first().is_some_and(|a| a == "modes"));
-        args.insert(at, "deck.dat".into());
+        // `modes` comes before the deck; everything else after it; `resume` takes no deck.
+        if args.first().is_none_or(|a| a != "resume") {
+            let at = usize::from(args.first().is_some_and(|a| a == "modes"));
+            args.insert(at, "deck.dat".into());
+        }
         let mut child = Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
             .args(&args)
             .current_dir(sandbox.path())
