@@ -73,6 +73,56 @@ impl RunOptions {
     }
 }
 
+/// The longest line a message of the command line echoes, characters.
+pub const ECHO_LINE_CHARS: usize = 200;
+
+/// `text` with every line longer than [`ECHO_LINE_CHARS`] cut there (with `…` and its
+/// length): no message grows with the input it quotes.
+pub fn cap_lines(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(64 << 10));
+    for line in text.split_inclusive('\n') {
+        match line.char_indices().nth(ECHO_LINE_CHARS) {
+            Some((i, _)) => {
+                out.push_str(&line[..i]);
+                out.push_str(&format!("… ({} characters)", line.chars().count()));
+                if line.ends_with('\n') {
+                    out.push('\n');
+                }
+            }
+            None => out.push_str(line),
+        }
+    }
+    out
+}
+
+/// clap's parser of `--set` ([`parse_set`]): its refusal says what is wrong, at which
+/// character, quoting at most a short prefix — not the whole argument, as clap's own
+/// message of an invalid value does.
+#[derive(Clone, Debug)]
+pub struct SetParser;
+
+impl clap::builder::TypedValueParser for SetParser {
+    type Value = (String, f64);
+
+    fn parse_ref(
+        &self,
+        _cmd: &clap::Command,
+        _arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<Self::Value, clap::Error> {
+        let refuse = |msg: String| {
+            clap::Error::raw(
+                clap::error::ErrorKind::ValueValidation,
+                format!("--set: {msg}\n"),
+            )
+        };
+        let s = value
+            .to_str()
+            .ok_or_else(|| refuse("the value is not UTF-8 text".into()))?;
+        parse_set(s).map_err(refuse)
+    }
+}
+
 /// Reads `name=value` (`--set`): a parameter name and a number or an expression of numbers
 /// (`E=2.1e11`, `h=1e-4/2`).
 pub fn parse_set(arg: &str) -> Result<(String, f64), String> {
@@ -115,11 +165,35 @@ pub fn load_refined(path: &Path, refine: u32) -> Result<Model, u8> {
 
 /// Parses a deck with parameter overrides (`--set`) and refines its mesh by `refine`.
 pub fn load_variant(path: &Path, set: &[(String, f64)], refine: u32) -> Result<Model, u8> {
-    let mut model = load_with(path, set)?;
-    apply_refine(path, &mut model, refine)?;
-    Ok(model)
+    load_source(path, set, refine).map(|(m, _)| m)
 }
 
+/// Reads the deck once ([`deck::read_source`]: a regular file or a pipe, bounded), parses
+/// it with the overrides `set`, refines it by `refine`; the model and the very text parsed
+/// (what messages locate in, what a checkpoint names). Diagnostics printed on error.
+pub fn load_source(path: &Path, set: &[(String, f64)], refine: u32) -> Result<(Model, String), u8> {
+    let text = deck::read_source(path).map_err(|errs| {
+        eprintln!("{:?}", miette::Report::new(errs));
+        EXIT_BAD_INPUT
+    })?;
+    let name = path.display().to_string();
+    let mut model = deck::parse_deck_with(&text, &name, set).map_err(|errs| {
+        eprintln!("{:?}", miette::Report::new(errs));
+        EXIT_BAD_INPUT
+    })?;
+    apply_refine(path, &mut model, refine)?;
+    Ok((model, text))
+}
+
+/// `path:line:col` of the byte `span.start` of the deck text `text` read from `path`.
+pub fn locate(path: &Path, text: &str, span: crate::model::Span) -> String {
+    let (line, col) = deck::line_col(text, span.start);
+    format!("{}:{line}:{col}", path.display())
+}
+
+/// Refines the model by `refine` (0 or 1: as written), then checks that the whole of it —
+/// nodes, elements, the unknowns' system, the output's buffers — fits in the memory the
+/// process may take (`--max-memory`, else what is available: [`crate::model::budget`]).
 fn apply_refine(path: &Path, model: &mut Model, refine: u32) -> Result<(), u8> {
     if refine > 1 {
         model.refine(refine).map_err(|e| {
@@ -127,7 +201,10 @@ fn apply_refine(path: &Path, model: &mut Model, refine: u32) -> Result<(), u8> {
             EXIT_BAD_INPUT
         })?;
     }
-    Ok(())
+    crate::model::budget::check(model.footprint(), "the model").map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        EXIT_BAD_INPUT
+    })
 }
 
 /// Parses a deck read once with the overrides `set`, refines it by `refine`, and names it:
@@ -137,20 +214,7 @@ pub fn load_identified(
     set: &[(String, f64)],
     refine: u32,
 ) -> Result<(Model, DeckIdentity), u8> {
-    // A file beyond the deck size limit is not read whole: the loader refuses it.
-    let too_large =
-        std::fs::metadata(path).is_ok_and(|m| m.len() > deck::limits::MAX_DECK_BYTES as u64);
-    let text = match (!too_large).then(|| std::fs::read(path).map(String::from_utf8)) {
-        Some(Ok(Ok(t))) => t,
-        // Unreadable or not UTF-8: the loader says so, with its diagnostics.
-        _ => return Err(load_with(path, set).err().unwrap_or(EXIT_BAD_INPUT)),
-    };
-    let name = path.display().to_string();
-    let mut model = deck::parse_deck_with(&text, &name, set).map_err(|errs| {
-        eprintln!("{:?}", miette::Report::new(errs));
-        EXIT_BAD_INPUT
-    })?;
-    apply_refine(path, &mut model, refine)?;
+    let (model, text) = load_source(path, set, refine)?;
     let id = deck_identity(path, &text, set, refine);
     Ok((model, id))
 }
@@ -227,19 +291,13 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
 }
 
 /// `file:line:col` of a byte offset of the deck at `path` (its text read again), or the
-/// path alone when the offset is not in it.
-pub fn locate(path: &Path, offset: usize) -> String {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    if offset > text.len() || !text.is_char_boundary(offset) {
-        return path.display().to_string();
+/// path alone when the deck cannot be read again (a pipe is not: it was read once).
+fn locate_offset(path: &Path, offset: usize) -> String {
+    let regular = std::fs::metadata(path).is_ok_and(|m| m.is_file());
+    match deck::read_text(path).ok().filter(|_| regular) {
+        Some(text) => locate(path, &text, crate::model::Span::new(offset, offset)),
+        None => path.display().to_string(),
     }
-    let before = &text[..offset];
-    let line = before.matches('\n').count() + 1;
-    let col = before[before.rfind('\n').map_or(0, |p| p + 1)..]
-        .chars()
-        .count()
-        + 1;
-    format!("{}:{line}:{col}", path.display())
 }
 
 /// A build error of the solver with its place in the deck where it has one (nodes whose
@@ -248,7 +306,7 @@ pub fn located_build_error(path: &Path, e: &solver::BuildError) -> String {
     match e {
         solver::BuildError::Undetermined(nodes) => nodes
             .iter()
-            .map(|n| format!("{}: {n}", locate(path, n.span.start)))
+            .map(|n| format!("{}: {n}", locate_offset(path, n.span.start)))
             .collect::<Vec<_>>()
             .join("\nerror: "),
         other => format!("{}: {other}", path.display()),
@@ -425,10 +483,7 @@ fn start_session(
     }
     // A checkpoint of an earlier run in this directory belongs to files just replaced.
     for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
-        match std::fs::remove_file(dir.join(name)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io_err(e)),
-            _ => {}
-        }
+        crate::safe_file::remove_regular(&dir.join(name)).map_err(io_err)?;
     }
     let vtk = if model.output.vtk {
         Some(VtkWriter::create(dir, model, &integ.sys).map_err(io_err)?)
@@ -531,10 +586,11 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let (model, id) = match load_identified(path, &opts.set, opts.refine) {
+    let (model, text) = match load_source(path, &opts.set, opts.refine) {
         Ok(m) => m,
         Err(code) => return code,
     };
+    let id = deck_identity(path, &text, &opts.set, opts.refine);
     let dir = opts
         .out_dir
         .clone()
@@ -543,7 +599,9 @@ pub fn run(path: &Path, opts: &RunOptions) -> u8 {
     // initial state, written into the run's directory (no time run, no checkpoint).
     if let Some(n) = model.modes {
         let about = crate::modes::about::deck_about(&model);
-        return modes::run_loaded(path, &model, about, n as usize, &dir, opts.quiet);
+        return modes::run_loaded(
+            path, &text, &model, about, n as usize, &dir, opts.quiet, opts.force,
+        );
     }
     let what = path.display().to_string();
     let plan = CheckpointPlan::new(every, id);

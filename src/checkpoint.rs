@@ -27,6 +27,9 @@ use std::path::{Path, PathBuf};
 
 /// Name of the checkpoint in an output directory.
 pub const FILE_NAME: &str = "checkpoint.bin";
+/// Largest checkpoint read, bytes: a bound for the reader only (a checkpoint is read as a
+/// regular file of the directory, never through a link or from a device).
+const MAX_BYTES: u64 = 1 << 40;
 /// Name of the checkpoint being written (renamed to [`FILE_NAME`] once whole).
 pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// Version of the file format; a checkpoint of another version is refused. (2: the
@@ -162,7 +165,7 @@ fn failpoint(count: u64) -> bool {
 pub fn write(dir: &Path, c: &Checkpoint, count: u64) -> io::Result<()> {
     let bytes = encode(c)?;
     let tmp = dir.join(TMP_NAME);
-    let mut f = File::create(&tmp)?;
+    let mut f = crate::safe_file::create(&tmp)?;
     if failpoint(count) {
         f.write_all(&bytes[..bytes.len() / 2])?;
         f.sync_all()?;
@@ -182,7 +185,7 @@ pub fn write(dir: &Path, c: &Checkpoint, count: u64) -> io::Result<()> {
 /// Reads `dir/checkpoint.bin`.
 pub fn read(dir: &Path) -> Result<Checkpoint, CheckpointError> {
     let path = dir.join(FILE_NAME);
-    let bytes = match fs::read(&path) {
+    let bytes = match crate::safe_file::read_bounded(&path, MAX_BYTES) {
         Ok(b) => b,
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             return Err(CheckpointError::Missing(dir.to_path_buf()));

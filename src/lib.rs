@@ -22,6 +22,7 @@ pub mod modes;
 pub mod output;
 pub mod plot;
 pub mod rotation;
+pub mod safe_file;
 pub mod scenes;
 pub mod solver;
 pub mod study;

@@ -62,8 +62,13 @@ struct Cli {
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     refine: u32,
     /// Override a deck parameter (PARAMETERS section): `--set E=2.1e10`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = mecano::app::parse_set)]
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = mecano::app::SetParser)]
     set: Vec<(String, f64)>,
+    /// The memory the run may take (e.g. 512M, 8G; powers of 1024): a model whose
+    /// estimated size exceeds it is refused before it is built (exit 2, with the figure).
+    /// Default: the memory available (MemAvailable, or a cgroup's limit).
+    #[arg(long = "max-memory", value_name = "SIZE", value_parser = mecano::model::budget::parse_size, global = true)]
+    max_memory: Option<u64>,
 }
 
 /// Subcommands: one variant each, the logic in the library.
@@ -103,7 +108,25 @@ restart is refused: no valid checkpoint, a complete run, or a deck whose text di
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind as E;
+            if matches!(
+                e.kind(),
+                E::DisplayHelp | E::DisplayVersion | E::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
+                e.exit();
+            }
+            // clap's message quotes the argument it refuses whole: each line is cut to a
+            // bound (a `--set` of 60,000 nested parentheses echoed 120 kB).
+            eprint!("{}", mecano::app::cap_lines(&e.render().to_string()));
+            return ExitCode::from(mecano::app::EXIT_BAD_INPUT);
+        }
+    };
+    if let Some(bytes) = cli.max_memory {
+        mecano::model::budget::set_max_memory(bytes);
+    }
     let code = match (&cli.command, &cli.deck) {
         (Some(Command::Plot(args)), _) => mecano::plot::run(args),
         (Some(Command::Study(args)), _) => mecano::study::run(args),

@@ -17,6 +17,8 @@ struct Counting;
 thread_local! {
     static COUNTING: Cell<bool> = const { Cell::new(false) };
     static ALLOCS: Cell<u64> = const { Cell::new(0) };
+    /// The largest single allocation (or reallocation's new size) while counting, bytes.
+    static LARGEST: Cell<usize> = const { Cell::new(0) };
 }
 
 fn count() {
@@ -24,6 +26,21 @@ fn count() {
     if on {
         let _ = ALLOCS.try_with(|a| a.set(a.get() + 1));
     }
+}
+
+fn size(bytes: usize) {
+    if COUNTING.try_with(Cell::get).unwrap_or(false) {
+        let _ = LARGEST.try_with(|l| l.set(l.get().max(bytes)));
+    }
+}
+
+/// The largest single allocation `f` makes on this thread, bytes.
+fn largest_allocation_in<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    LARGEST.with(|l| l.set(0));
+    COUNTING.with(|c| c.set(true));
+    let out = f();
+    COUNTING.with(|c| c.set(false));
+    (out, LARGEST.with(Cell::get))
 }
 
 /// Counts the allocations `f` makes on this thread.
@@ -38,14 +55,17 @@ fn allocations_in<T>(f: impl FnOnce() -> T) -> (T, u64) {
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         count();
+        size(layout.size());
         unsafe { System.alloc(layout) }
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         count();
+        size(layout.size());
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         count();
+        size(new_size);
         unsafe { System.realloc(ptr, layout, new_size) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
@@ -213,4 +233,43 @@ fn the_contact_path_does_not_allocate() {
         "heap allocations through the impact: {at_events} in the {events} steps with a restart or \
          a refused attempt, {elsewhere} in the others"
     );
+}
+
+/// Memory asked before it is taken (issue 35 §2): a model too large for the memory the
+/// process may take is refused before its nodes are generated, so that no refused input
+/// allocates more than 100 MB at once — a deck dividing the pendulum's bars a million
+/// times each, `--refine 1000000` of the pendulum, generations of a million nodes. The
+/// limit is set here (1 GiB, as `--max-memory 1G`), so the refusal does not depend on the
+/// machine; every other test of this file asks far less.
+#[test]
+fn a_refused_model_never_allocates_100_mb() {
+    mecano::model::budget::set_max_memory(1 << 30);
+    let seed = include_str!("../decks/pendulum.dat");
+    let divided = seed.replace(
+        "2 TO 11  BEAM 2 3  MAT 1 SEC 1",
+        "2 TO 11  BEAM 2 3  MAT 1 SEC 1 DIVIDE 1000000",
+    );
+    assert_ne!(divided, seed);
+    let generated = "NODES\n  1 TO 1000000 LINE 0 0 0 1 0 0\n  1000001 TO 2000000 LINE 0 0 0 1 0 0\nANALYSIS STATIC STEPS 1\n";
+    let beams = "MATERIALS\n 1 E 2e11 NU 0.3 RHO 7800\nSECTIONS\n 1 A 1e-4 I2 1e-9 I3 1e-9 J 2e-9\nNODES\n 1 0 0 0\n 2 1 0 0\nELEMENTS\n 1 BEAM 1 2 MAT 1 SEC 1 DIVIDE 1000000\nANALYSIS STATIC STEPS 1\n";
+    const BOUND: usize = 100_000_000;
+    for (name, text) in [
+        ("DIVIDE", divided.as_str()),
+        ("TO", generated),
+        ("one beam", beams),
+    ] {
+        let (r, largest) = largest_allocation_in(|| mecano::deck::parse_deck(text, "big.dat"));
+        let e = r.expect_err(name);
+        assert!(e.to_string().contains("--max-memory"), "{name}: {e}");
+        assert!(largest < BOUND, "{name}: an allocation of {largest} bytes");
+    }
+    let mut model = mecano::deck::parse_deck(seed, "seed.dat").unwrap();
+    let (r, largest) = largest_allocation_in(|| model.refine(1_000_000));
+    let e = r.expect_err("--refine 1000000");
+    assert!(e.to_string().contains("--max-memory"), "{e}");
+    assert!(
+        largest < BOUND,
+        "--refine: an allocation of {largest} bytes"
+    );
+    mecano::model::budget::set_max_memory(0);
 }

@@ -53,11 +53,15 @@ pub struct ModesArgs {
     #[arg(long, value_name = "P")]
     pub order: Option<u32>,
     /// Override a deck parameter: `--set E=2.1e10`; repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = app::parse_set)]
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = app::SetParser)]
     pub set: Vec<(String, f64)>,
     /// No table on standard output.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Write into an output directory that holds files no mecano-rs run wrote there (they
+    /// are left as they are), as for runs.
+    #[arg(long)]
+    pub force: bool,
     /// Eigen-solver: `auto` (sparse from 300 unknowns: shift-invert Lanczos for a
     /// conservative model, Arnoldi on the first-order form for a damped or gyroscopic one;
     /// dense otherwise), `dense` or `sparse`.
@@ -248,26 +252,41 @@ pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
     }
 }
 
-/// The frame error with the deck's path and, when it has a place, its line and column.
-fn located(deck: &Path, e: &FrameError) -> String {
-    let span = match e {
-        FrameError::OtherDriver { span, .. }
-        | FrameError::NotGrounded { span, .. }
-        | FrameError::NotConstant { span, .. } => Some(*span),
-        _ => None,
-    };
-    let text = std::fs::read_to_string(deck).unwrap_or_default();
-    match span.filter(|s| s.start <= text.len() && text.is_char_boundary(s.start)) {
-        Some(s) => {
-            let before = &text[..s.start];
-            let line = before.matches('\n').count() + 1;
-            let col = before[before.rfind('\n').map_or(0, |p| p + 1)..]
-                .chars()
-                .count()
-                + 1;
-            format!("{}:{line}:{col}: --rotating: {e}", deck.display())
+/// Where a refusal of the modal analysis points: the deck's text, and whether the count
+/// and the rotating state came from its `ANALYSIS MODES n [ROTATING]` card (else from the
+/// command line: `--count`, `--rotating`).
+struct Source<'a> {
+    deck: &'a Path,
+    text: &'a str,
+    count_from_deck: bool,
+    rotating_from_deck: bool,
+}
+
+impl Source<'_> {
+    /// `deck:line:col` of `span`.
+    fn at(&self, span: crate::model::Span) -> String {
+        app::locate(self.deck, self.text, span)
+    }
+
+    /// The frame error at its element when it has one, else at the deck's `ANALYSIS MODES
+    /// … ROTATING` card (or named as `--rotating`'s).
+    fn frame_error(&self, model: &Model, e: &FrameError) -> String {
+        let span = match e {
+            FrameError::OtherDriver { span, .. }
+            | FrameError::NotGrounded { span, .. }
+            | FrameError::NotConstant { span, .. } => Some(*span),
+            _ => None,
+        };
+        let asked = if self.rotating_from_deck {
+            "ANALYSIS MODES … ROTATING"
+        } else {
+            "--rotating"
+        };
+        match (span, self.rotating_from_deck) {
+            (Some(s), _) => format!("{}: {asked}: {e}", self.at(s)),
+            (None, true) => format!("{}: {asked}: {e}", self.at(model.modes_span)),
+            (None, false) => format!("{}: {asked}: {e}", self.deck.display()),
         }
-        None => format!("{}: --rotating: {e}", deck.display()),
     }
 }
 
@@ -288,22 +307,43 @@ pub fn load(
     refine: u32,
     order: Option<u32>,
 ) -> Result<Model, u8> {
-    let mut model = app::load_variant(path, set, refine)?;
+    load_text(path, set, refine, order).map(|(m, _)| m)
+}
+
+/// [`load`], with the deck's text (for located messages).
+fn load_text(
+    path: &Path,
+    set: &[(String, f64)],
+    refine: u32,
+    order: Option<u32>,
+) -> Result<(Model, String), u8> {
+    let (mut model, text) = app::load_source(path, set, refine)?;
     if let Some(p) = order {
         model.set_beam_order(p).map_err(|e| {
             eprintln!("error: {}: --order {p}: {e}", path.display());
             EXIT_BAD_INPUT
         })?;
     }
-    Ok(model)
+    Ok((model, text))
 }
 
 /// `mecano-rs modes`: returns the exit code.
 pub fn run(args: &ModesArgs) -> u8 {
-    let model = match load(&args.deck, &args.set, args.refine, args.order) {
+    let (model, text) = match load_text(&args.deck, &args.set, args.refine, args.order) {
         Ok(m) => m,
         Err(code) => return code,
     };
+    // A deck of `ANALYSIS MODES n ROTATING` is linearised about its rotating state: a
+    // request for another state is refused, not ignored (issue 35 §5: `--at 0.1` gave the
+    // rotating modes, silently).
+    if model.modes_rotating && !args.rotating && (args.at.is_some() || args.statics) {
+        let what = if args.statics { "--static" } else { "--at" };
+        eprintln!(
+            "error: {}: {what}: this deck's ANALYSIS MODES … ROTATING asks for the modes about the hub's rotating state; {what} asks for another state: remove one of them",
+            app::locate(&args.deck, &text, model.modes_span)
+        );
+        return EXIT_BAD_INPUT;
+    }
     let about = match (args.statics, args.at) {
         _ if args.rotating || model.modes_rotating => About::Rotating,
         (true, _) => About::Static,
@@ -312,48 +352,85 @@ pub fn run(args: &ModesArgs) -> u8 {
     };
     let count = args.count.or(model.modes).map_or(10, |c| c as usize);
     let dir = out_dir(args, &model);
-    run_loaded_using(
-        &args.deck,
+    let source = Source {
+        deck: &args.deck,
+        text: &text,
+        count_from_deck: args.count.is_none() && model.modes.is_some(),
+        rotating_from_deck: !args.rotating && model.modes_rotating,
+    };
+    analyse_and_write(
+        &source,
         &model,
         about,
         count,
         &dir,
-        args.quiet,
+        (args.quiet, args.force),
         args.solver.into(),
     )
 }
 
-/// The modal analysis of a loaded model into `dir`: `mecano-rs modes`, and
-/// `mecano-rs DECK` on a deck of `ANALYSIS MODES n` (about the initial state, into the
-/// run's output directory). Returns the exit code.
+/// The modal analysis of a loaded model (read from `deck`, whose text is `text`) into
+/// `dir`: `mecano-rs DECK` on a deck of `ANALYSIS MODES n` (about the initial state, or
+/// the rotating state with `ROTATING`, into the run's output directory), a sweep's case of
+/// such a deck. Returns the exit code.
+#[allow(clippy::too_many_arguments)]
 pub fn run_loaded(
     deck: &Path,
+    text: &str,
     model: &Model,
     about: About,
     count: usize,
     dir: &Path,
     quiet: bool,
+    force: bool,
 ) -> u8 {
-    run_loaded_using(deck, model, about, count, dir, quiet, Solver::Auto)
+    let source = Source {
+        deck,
+        text,
+        count_from_deck: true,
+        rotating_from_deck: model.modes_rotating,
+    };
+    analyse_and_write(
+        &source,
+        model,
+        about,
+        count,
+        dir,
+        (quiet, force),
+        Solver::Auto,
+    )
 }
 
-fn run_loaded_using(
-    deck: &Path,
+fn analyse_and_write(
+    source: &Source<'_>,
     model: &Model,
     about: About,
     count: usize,
     dir: &Path,
-    quiet: bool,
+    (quiet, force): (bool, bool),
     solver: Solver,
 ) -> u8 {
+    let deck = source.deck;
     if about == About::Rotating
         && let Err(e) = Frame::from_model(model, 0.0)
     {
-        eprintln!("error: {}", located(deck, &e));
+        eprintln!("error: {}", source.frame_error(model, &e));
         return EXIT_BAD_INPUT;
     }
     let (integ, a) = match analyse_model_using(model, about, count, solver) {
         Ok(r) => r,
+        Err(f) if f.too_many && source.count_from_deck => {
+            eprintln!(
+                "error: {}: ANALYSIS MODES {count}: {}",
+                source.at(model.modes_span),
+                f.message
+            );
+            return EXIT_BAD_INPUT;
+        }
+        Err(f) if f.too_many => {
+            eprintln!("error: {}: --count {count}: {}", deck.display(), f.message);
+            return EXIT_BAD_INPUT;
+        }
         Err(f) => {
             eprintln!("error: {}: {}", deck.display(), f.message);
             return if f.bad_input {
@@ -398,6 +475,15 @@ fn run_loaded_using(
             "point": [f.point.x, f.point.y, f.point.z],
         });
     }
+    // The directory is claimed as a run's is (app::outdir: its lock, the previous
+    // analysis's files replaced, foreign ones refused, nothing written through a link).
+    let _claim = match app::outdir::OutDir::claim_fresh(dir, &app::outdir::modes_files(), force) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {}: {e}", deck.display());
+            return EXIT_BAD_INPUT;
+        }
+    };
     let written = output::write_all(
         dir,
         &a,

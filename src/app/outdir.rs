@@ -6,18 +6,28 @@
 //!   for the whole run or restart. The kernel releases it when the process ends, however
 //!   it ends (a crash, SIGKILL), so a lock is never left stuck; the file itself stays,
 //!   empty (a run's directory is the same, byte for byte, however often it was resumed).
-//! - **Manifest.** `.mecano-manifest`: one path per line, relative to the directory, of
-//!   every file this run may write (histories, `summary.json`, the checkpoint, the VTK
-//!   series). It is written before the first of them. A fresh run removes what the
-//!   previous run's manifest lists (and only that), and refuses a directory holding files
-//!   of anyone else unless `--force` is given (they are then left where they are;
-//!   subdirectories, e.g. `study/`, are never touched nor counted). `resume` takes the
-//!   lock and removes nothing.
+//!   It is opened without following links: a `.mecano-lock` that is a link (dangling or
+//!   not) is refused, and nothing is created where it points.
+//! - **Manifest.** `.mecano-manifest`: one plain name per line of every file this run may
+//!   write in the directory (histories, `summary.json`, the checkpoint, the VTK
+//!   collection), and `vtk/` for the run's frames. It is written before the first of them.
+//!   A fresh run removes the *regular files* the previous run's manifest names (never
+//!   through a link, never in a subdirectory: an entry with a `/`, `..` or an absolute
+//!   path is ignored; a listed name that is a link or a directory is left alone), and
+//!   refuses a directory holding files of anyone else unless `--force` is given (they are
+//!   then left where they are; subdirectories, e.g. `study/`, are never touched nor
+//!   counted). A name the run writes that is held by a link, a directory, a FIFO or a
+//!   foreign file is refused, `--force` or not: no file is written over that the previous
+//!   run's manifest does not name. `resume` takes the lock and removes nothing.
+//! - Every file of the directory is then opened through [`crate::safe_file`]
+//!   (`O_NOFOLLOW`, regular files only).
 //!
 //! Every refusal is bad input (exit code 2): an output path that is a file, `/dev/null`,
-//! below a file, not creatable, a directory in use, or holding foreign files.
+//! below a file, not creatable, a directory in use, holding foreign files, or a name of
+//! the run taken.
 
-use std::fs::{self, File, OpenOptions};
+use crate::safe_file;
+use std::fs::{self, File};
 use std::io;
 use std::os::fd::AsRawFd;
 use std::path::{Path, PathBuf};
@@ -64,6 +74,16 @@ pub enum OutDirError {
         /// The first few names, comma separated.
         list: String,
     },
+    /// A name the run writes is held by something it must not write over or through.
+    #[error(
+        "the output directory {path} cannot be used: {why}; a run writes only regular files of its directory that no one else wrote (--force leaves foreign files alone, so it cannot write over them): remove it, or choose another directory with -o"
+    )]
+    Taken {
+        /// The directory.
+        path: PathBuf,
+        /// What holds the name.
+        why: String,
+    },
 }
 
 /// A claimed output directory: holds the lock until dropped.
@@ -80,6 +100,9 @@ fn unusable(dir: &Path, e: &io::Error) -> OutDirError {
     }
 }
 
+/// Largest manifest read, bytes (a run selecting 300,000 files lists some 6 MB).
+const MAX_MANIFEST_BYTES: u64 = 64 << 20;
+
 impl OutDir {
     /// Takes the lock of an existing directory (a restart): nothing is removed.
     pub fn lock_existing(dir: &Path) -> Result<Self, OutDirError> {
@@ -95,15 +118,25 @@ impl OutDir {
 
     /// Claims `dir` for a fresh run that will write `files` (paths relative to `dir`):
     /// creates it, takes its lock, refuses it when it holds files the previous run's
-    /// manifest does not list (unless `force`), removes those the manifest lists, and
-    /// writes the new manifest.
+    /// manifest does not list (unless `force`), or when a name this run writes is taken by
+    /// anything but a regular file the previous run wrote (a link, a directory, a foreign
+    /// file: also with `force`); removes the regular files the manifest lists, and writes
+    /// the new manifest.
     pub fn claim_fresh(dir: &Path, files: &[String], force: bool) -> Result<Self, OutDirError> {
         if dir.exists() && !dir.is_dir() {
             return Err(OutDirError::NotADirectory(dir.to_path_buf()));
         }
         // Refused before anything is written into it (not even the lock file); checked
-        // again under the lock, which another run may have held meanwhile.
-        if dir.is_dir() && !force {
+        // again under the lock, which another run may have held meanwhile. A run starting
+        // at the same moment may have written files its manifest (not yet read here)
+        // lists: then the lock is held, and the directory is in use, not foreign.
+        if dir.is_dir() && !force && refuse_foreign(dir).is_err() {
+            if held_by_another(dir) {
+                return Err(OutDirError::Busy {
+                    path: dir.to_path_buf(),
+                });
+            }
+            // Read again: a run that ended meanwhile has its manifest in place now.
             refuse_foreign(dir)?;
         }
         fs::create_dir_all(dir).map_err(|e| unusable(dir, &e))?;
@@ -113,6 +146,7 @@ impl OutDir {
         } else {
             refuse_foreign(dir)?
         };
+        refuse_taken(dir, files, &old)?;
         for entry in &old {
             remove_entry(dir, entry).map_err(|e| unusable(dir, &e))?;
         }
@@ -136,7 +170,11 @@ fn refuse_foreign(dir: &Path) -> Result<Vec<String>, OutDirError> {
     if foreign.is_empty() {
         return Ok(old);
     }
-    let mut list: Vec<String> = foreign.iter().take(5).cloned().collect();
+    let mut list: Vec<String> = foreign
+        .iter()
+        .take(5)
+        .map(|n| crate::deck::short(n))
+        .collect();
     if foreign.len() > 5 {
         list.push(format!("and {} more", foreign.len() - 5));
     }
@@ -146,16 +184,73 @@ fn refuse_foreign(dir: &Path) -> Result<Vec<String>, OutDirError> {
     })
 }
 
-/// Opens (creating) the lock file and takes an exclusive, non-blocking `flock`.
+/// The names this run writes that something other than a regular file of the previous
+/// run holds: a link (dangling or not), a directory, a FIFO, or a file the previous run's
+/// manifest does not list (which `--force` leaves alone, so it cannot be written over).
+/// `vtk/` must be a real directory the previous run wrote, its frames regular files.
+fn refuse_taken(dir: &Path, files: &[String], old: &[String]) -> Result<(), OutDirError> {
+    let taken = |why: String| {
+        Err(OutDirError::Taken {
+            path: dir.to_path_buf(),
+            why,
+        })
+    };
+    for f in files {
+        if f == VTK_DIR {
+            let sub = dir.join(VTK_DIR.trim_end_matches('/'));
+            if let Some(kind) = safe_file::non_regular_kind(&sub)
+                && kind != "a directory"
+            {
+                return taken(format!("vtk is {kind}"));
+            }
+            if sub.is_dir() && !old.iter().any(|o| o == VTK_DIR) {
+                return taken("vtk/ is a directory no mecano-rs run wrote".into());
+            }
+            if sub.is_dir() {
+                for e in fs::read_dir(&sub).map_err(|e| unusable(dir, &e))? {
+                    let e = e.map_err(|e| unusable(dir, &e))?;
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    let ft = e.file_type().map_err(|e| unusable(dir, &e))?;
+                    if is_frame(&name) && !ft.is_file() {
+                        return taken(format!(
+                            "vtk/{} is not a regular file",
+                            crate::deck::short(&name)
+                        ));
+                    }
+                }
+            }
+            continue;
+        }
+        let p = dir.join(f);
+        if let Some(kind) = safe_file::non_regular_kind(&p) {
+            return taken(format!("{f} is {kind}"));
+        }
+        if p.is_file() && !old.contains(f) {
+            return taken(format!(
+                "{f} is a file no mecano-rs run wrote (its manifest does not list it), and this run would write over it"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether another process holds the lock of `dir` (its lock file exists and cannot be
+/// locked now). Takes and drops the lock when free; creates nothing.
+fn held_by_another(dir: &Path) -> bool {
+    let Ok(file) = safe_file::read_write(&dir.join(LOCK_NAME)) else {
+        return false;
+    };
+    // SAFETY: flock(2) on a descriptor this `File` owns; no memory is shared.
+    let rc = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    rc != 0 && io::Error::last_os_error().raw_os_error() == Some(libc::EWOULDBLOCK)
+}
+
+/// Opens (creating) the lock file and takes an exclusive, non-blocking `flock`. Never
+/// through a link: a `.mecano-lock` that is a link (dangling or not), a FIFO or a
+/// directory is refused, and nothing is created where a link points.
 fn lock(dir: &Path) -> Result<File, OutDirError> {
     let path = dir.join(LOCK_NAME);
-    let file = OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .map_err(|e| unusable(dir, &e))?;
+    let file = safe_file::open_or_create(&path).map_err(|e| unusable(dir, &e))?;
     // SAFETY: flock(2) on a descriptor this `File` owns; no memory is shared.
     let rc = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
     if rc != 0 {
@@ -170,24 +265,38 @@ fn lock(dir: &Path) -> Result<File, OutDirError> {
     Ok(file)
 }
 
-/// The entries of the manifest in `dir` (empty when there is none). Entries that could
-/// leave the directory (absolute, `..`) are dropped: a manifest never removes anything
-/// outside its directory.
+/// Whether a manifest entry may name something the run wrote: a plain name of the
+/// directory (one component, not `.` or `..`, not the lock or the manifest), or `vtk/`.
+/// Anything else (`sub/victim.txt`, `/etc/passwd`, `../x`) is dropped: a manifest never
+/// removes anything outside its directory, nor in a subdirectory of it.
+fn plain_entry(line: &str) -> bool {
+    if line == VTK_DIR {
+        return true;
+    }
+    let mut parts = Path::new(line).components();
+    matches!(
+        (parts.next(), parts.next()),
+        (Some(std::path::Component::Normal(_)), None)
+    ) && !line.contains('/')
+        && line != LOCK_NAME
+        && line != MANIFEST_NAME
+}
+
+/// The entries of the manifest in `dir` (empty when there is none), plain names only
+/// ([`plain_entry`]). The manifest is read only as a regular file of the directory, and
+/// only up to [`MAX_MANIFEST_BYTES`].
 fn read_manifest(dir: &Path) -> io::Result<Vec<String>> {
-    let text = match fs::read_to_string(dir.join(MANIFEST_NAME)) {
-        Ok(t) => t,
-        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(e),
-    };
+    let path = dir.join(MANIFEST_NAME);
+    if fs::symlink_metadata(&path).is_err_and(|e| e.kind() == io::ErrorKind::NotFound) {
+        return Ok(Vec::new());
+    }
+    let bytes = safe_file::read_bounded(&path, MAX_MANIFEST_BYTES)?;
+    let text = String::from_utf8_lossy(&bytes);
     Ok(text
         .lines()
         .map(str::trim)
         .filter(|l| !l.is_empty() && !l.starts_with('#'))
-        .filter(|l| {
-            let p = Path::new(l.trim_end_matches('/'));
-            p.components()
-                .all(|c| matches!(c, std::path::Component::Normal(_)))
-        })
+        .filter(|l| plain_entry(l))
         .map(str::to_string)
         .collect())
 }
@@ -201,12 +310,12 @@ fn write_manifest(dir: &Path, files: &[String]) -> io::Result<()> {
         text.push('\n');
     }
     let tmp = dir.join(format!("{MANIFEST_NAME}.tmp"));
-    fs::write(&tmp, text)?;
-    fs::rename(tmp, dir.join(MANIFEST_NAME))
+    safe_file::write_atomic(&tmp, &dir.join(MANIFEST_NAME), text.as_bytes())
 }
 
-/// Names of the regular files (and links) at the top of `dir` that neither the manifest
-/// `old` lists nor this module keeps. Subdirectories do not count.
+/// Names of the entries at the top of `dir` other than directories (regular files,
+/// links — to directories too —, FIFOs) that neither the manifest `old` lists nor this
+/// module keeps. Real subdirectories do not count.
 fn foreign_files(dir: &Path, old: &[String]) -> io::Result<Vec<String>> {
     let mut out = Vec::new();
     for entry in fs::read_dir(dir)? {
@@ -227,35 +336,42 @@ fn foreign_files(dir: &Path, old: &[String]) -> io::Result<Vec<String>> {
     Ok(out)
 }
 
-/// Removes one manifest entry: a file (missing is fine), or for `vtk/` the frames in it
-/// and the directory once empty.
+/// A name a run writes in `vtk/`: a run's frame `frame_*.vtu`, a modal analysis's
+/// `mode_*.vtu` frame or `mode_*.pvd` series.
+fn is_frame(name: &str) -> bool {
+    (name.starts_with("frame_") && name.ends_with(".vtu"))
+        || (name.starts_with("mode_") && (name.ends_with(".vtu") || name.ends_with(".pvd")))
+}
+
+/// Removes one manifest entry: a regular file of the directory (missing is fine; a link,
+/// a directory or anything else by that name is left alone), or for `vtk/` — only when it
+/// is a real directory — the regular `frame_*.vtu` files in it and the directory once
+/// empty.
 fn remove_entry(dir: &Path, entry: &str) -> io::Result<()> {
     if entry == VTK_DIR {
-        let sub = dir.join(VTK_DIR);
-        let Ok(it) = fs::read_dir(&sub) else {
+        let sub = dir.join(VTK_DIR.trim_end_matches('/'));
+        let is_real_dir = fs::symlink_metadata(&sub).is_ok_and(|m| m.file_type().is_dir());
+        if !is_real_dir {
             return Ok(());
-        };
-        for e in it {
+        }
+        for e in fs::read_dir(&sub)? {
             let e = e?;
             let name = e.file_name().to_string_lossy().into_owned();
-            if name.starts_with("frame_") && name.ends_with(".vtu") {
-                remove_file(&e.path())?;
+            if is_frame(&name) && e.file_type()?.is_file() {
+                safe_file::remove_regular(&e.path())?;
             }
         }
         // Left in place if something else is in it.
         let _ = fs::remove_dir(&sub);
         return Ok(());
     }
-    if entry.ends_with('/') {
+    if !plain_entry(entry) {
         return Ok(());
     }
-    remove_file(&dir.join(entry))
-}
-
-fn remove_file(path: &Path) -> io::Result<()> {
-    match fs::remove_file(path) {
-        Err(e) if e.kind() != io::ErrorKind::NotFound => Err(e),
-        _ => Ok(()),
+    let path = dir.join(entry);
+    match safe_file::non_regular_kind(&path) {
+        Some(_) => Ok(()),
+        None => safe_file::remove_regular(&path),
     }
 }
 
@@ -278,4 +394,13 @@ pub fn run_files(histories: Vec<String>, vtk: bool) -> Vec<String> {
         files.push(VTK_DIR.to_string());
     }
     files
+}
+
+/// The files a modal analysis writes (`mecano-rs modes`, a deck of `ANALYSIS MODES n`):
+/// the table, the shapes, the summary and the ParaView series of each mode in `vtk/`.
+pub fn modes_files() -> Vec<String> {
+    ["modes.csv", "modes_shapes.csv", "summary.json", VTK_DIR]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
 }

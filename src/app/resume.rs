@@ -80,8 +80,10 @@ pub fn resume_run(
     }
     // The same lock as a fresh run's: a restart never writes beside another run.
     let claim = super::outdir::OutDir::lock_existing(dir).map_err(refuse)?;
-    let summary: Option<serde_json::Value> = match std::fs::read_to_string(dir.join("summary.json"))
-    {
+    let summary: Option<serde_json::Value> = match crate::safe_file::read_text(
+        &dir.join("summary.json"),
+        crate::safe_file::MAX_TEXT_BYTES,
+    ) {
         Ok(t) => match serde_json::from_str(&t) {
             Ok(v) => Some(v),
             Err(e) => return Err(refuse(format!("summary.json is not valid JSON ({e})"))),

@@ -252,7 +252,7 @@ impl Session<'_> {
             // A complete run is not resumed, and a failed one would fail again at the same
             // step (a restart is bit for bit): its checkpoint is of no more use.
             for name in [checkpoint::FILE_NAME, checkpoint::TMP_NAME] {
-                let _ = std::fs::remove_file(dir.join(name));
+                let _ = crate::safe_file::remove_regular(&dir.join(name));
             }
         }
         Ok(report)

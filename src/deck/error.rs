@@ -352,6 +352,15 @@ pub enum DeckErrorKind {
         /// Its unit (bytes, fields).
         unit: &'static str,
     },
+    /// A model that would not fit in the memory the process may take (model::budget),
+    /// refused before its nodes and elements are generated.
+    #[error("{request}: {reason}")]
+    ModelTooLarge {
+        /// What asked for it (`DIVIDE 1000000`).
+        request: String,
+        /// The estimate and the limit.
+        reason: String,
+    },
     /// A joint or CAME whose nodes repeat one node.
     #[error("{keyword} element {element} joins node {node} to itself: its nodes must differ")]
     NodeToItself {
@@ -500,7 +509,7 @@ impl DeckError {
                 "mecano::deck::undefined_parameter"
             }
             K::BadParameterName { .. } | K::DuplicateParameter { .. } => "mecano::deck::parameter",
-            K::TooLarge { .. } => "mecano::deck::too_large",
+            K::TooLarge { .. } | K::ModelTooLarge { .. } => "mecano::deck::too_large",
             K::NodeToItself { .. } | K::CameProfiles { .. } | K::SplinePointsCoincide { .. } => {
                 "mecano::deck::element"
             }

@@ -233,7 +233,9 @@ impl Parser<'_, '_> {
     /// Every recursion of the grammar (parentheses and calls via `expr`, signs, powers)
     /// passes here, so the depth is bounded here.
     fn unary(&mut self) -> Result<Node, ExprError> {
-        if self.depth >= MAX_DEPTH {
+        // The expression itself is not a level: MAX_DEPTH parentheses are accepted, as
+        // grammar.md says (issue 35 §5: 100 were refused).
+        if self.depth > MAX_DEPTH {
             self.blanks();
             return Err(ExprError {
                 at: self.pos,

@@ -19,6 +19,24 @@ pub const MAX_TOKEN_BYTES: usize = 1024;
 /// 49,999 `t f` pairs, a SPLINE of up to 49,990 points.
 pub const MAX_CARD_FIELDS: usize = 100_000;
 
+/// Largest magnitude of a real number of a deck's fields (issue 35 §1). The solver forms
+/// products of a few of them — a stiffness times a step squared over a mass, a coordinate
+/// squared, a frequency times the end time, a load's squared norm — and each such product
+/// of numbers within `[MIN_MAGNITUDE, MAX_MAGNITUDE]` stays within `[1e-300, 1e300]`, inside
+/// double precision (`2.2e-308 … 1.8e308`): a value beyond it would overflow at run time
+/// (1e308 in a coordinate, a stiffness, a load, a frequency), so it is refused as input,
+/// located. No quantity of mechanics in SI units comes near either bound.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+/// Smallest magnitude of a non-zero real number of a deck's fields ([`MAX_MAGNITUDE`]).
+pub const MIN_MAGNITUDE: f64 = 1e-100;
+/// The range [`magnitude_ok`] accepts, as error messages state it.
+pub const MAGNITUDE_RANGE: &str = "0, or a magnitude from 1e-100 to 1e100 (products of a few deck numbers, e.g. a stiffness times a step squared, must stay within double precision)";
+
+/// Whether `v` is 0 or of a magnitude within `[MIN_MAGNITUDE, MAX_MAGNITUDE]`.
+pub fn magnitude_ok(v: f64) -> bool {
+    v == 0.0 || (MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&v.abs())
+}
+
 /// A limit broken: the error and where to cut the source for its diagnostic.
 pub(crate) struct Broken {
     /// The error (located).

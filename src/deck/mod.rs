@@ -17,11 +17,13 @@ mod keywords;
 mod lex;
 pub mod limits;
 mod params;
+mod source;
 mod write;
 
 pub use error::{DeckError, DeckErrorKind, DeckErrors, ECHO_CHARS, short};
 pub(crate) use keywords::debug_check_keyword;
 pub use keywords::{KEYWORDS, KeywordDoc};
+pub use source::{PIPE_WAIT, read_source, read_text};
 pub use write::write_deck;
 
 use crate::model::{Model, Span};
@@ -52,6 +54,12 @@ pub fn parse_deck_with(
     let parameters = params::resolve(source, &mut cards, overrides, &mut errors);
     build::build_model(source, &cards, errors, empty, parameters)
         .map_err(|errors| DeckErrors::new(source, file_name, errors))
+}
+
+/// The 1-based line and column (in characters) of the byte `offset` of `text`: where a
+/// message that is not a [`DeckError`] points (`file:line:col`).
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    error::line_col(text, offset)
 }
 
 /// Whether `name` is a valid parameter name (a letter or `_`, then letters, digits, `_`).
@@ -89,66 +97,18 @@ pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
     load_deck_with(path, &[])
 }
 
-/// [`load_deck`] with parameter overrides (see [`parse_deck_with`]).
+/// [`load_deck`] with parameter overrides (see [`parse_deck_with`]). The text is read by
+/// [`read_source`]: a regular file or a pipe, at most the size limit plus one byte.
 pub fn load_deck_with(path: &Path, overrides: &[(String, f64)]) -> Result<Model, DeckErrors> {
-    let name = path.display().to_string();
-    let file_error = |kind| DeckErrors::new("", &name, vec![DeckError { kind, span: None }]);
-    let io = |e: std::io::Error| {
-        file_error(DeckErrorKind::Io {
-            path: name.clone(),
-            reason: e.to_string(),
-        })
-    };
-    // At most one byte past the limit is read: a larger file is refused, not loaded.
-    let mut bytes = Vec::new();
-    let file = std::fs::File::open(path).map_err(io)?;
-    std::io::Read::read_to_end(
-        &mut std::io::Read::take(file, limits::MAX_DECK_BYTES as u64 + 1),
-        &mut bytes,
-    )
-    .map_err(io)?;
-    let total = bytes.len();
-    match String::from_utf8(bytes) {
-        Ok(text) if total <= limits::MAX_DECK_BYTES => parse_deck_with(&text, &name, overrides),
-        Ok(text) => Err(limits::check_text(&text, total).err().map_or_else(
-            || file_error(DeckErrorKind::EmptyDeck),
-            |b| DeckErrors::new(&text[..b.cut], &name, vec![b.error]),
-        )),
-        Err(e) => {
-            // Located at the first invalid byte: the text before it is the source of the
-            // diagnostic (its lines are checked first, so the snippet stays short).
-            let offset = e.utf8_error().valid_up_to();
-            let valid = &e.as_bytes()[..offset];
-            let text = std::str::from_utf8(valid).unwrap_or_default();
-            // A file cut at the size limit may end inside a character: then it is too
-            // large, not malformed.
-            let cut_inside = total > limits::MAX_DECK_BYTES && offset + 4 > limits::MAX_DECK_BYTES;
-            let checked = limits::check_text(text, if cut_inside { total } else { offset });
-            let error = checked.err().unwrap_or_else(|| {
-                Box::new(limits::Broken {
-                    error: DeckError::new(
-                        DeckErrorKind::NotUtf8 {
-                            path: name.clone(),
-                            offset,
-                        },
-                        Span::new(offset, offset),
-                    ),
-                    cut: offset,
-                })
-            });
-            Err(DeckErrors::new(
-                &text[..error.cut],
-                &name,
-                vec![error.error],
-            ))
-        }
-    }
+    let text = read_source(path)?;
+    parse_deck_with(&text, &path.display().to_string(), overrides)
 }
 
 /// Sets every span in `model` to `Span::default()` (to compare models read from different
 /// texts).
 pub fn strip_spans(model: &mut Model) {
     let zero = Span::default();
+    model.modes_span = zero;
     model.nodes.values_mut().for_each(|x| x.span = zero);
     model.materials.values_mut().for_each(|x| x.span = zero);
     model.sections.values_mut().for_each(|x| x.span = zero);

@@ -171,7 +171,7 @@ pub enum ElementState {
 
 /// A saved [`ElementState`] that does not belong to the element it is given to.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("element {element}: the saved state is of another kind of element")]
+#[error("{element}: the saved state is of another kind of element")]
 pub struct StateMismatch {
     /// The element.
     pub element: ElementId,

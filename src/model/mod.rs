@@ -7,6 +7,7 @@
 //! **Invariant:** maps keep deck order; keys are the user's numbers.
 
 pub mod arc;
+pub mod budget;
 mod clearance;
 pub mod control;
 mod drive;
@@ -443,6 +444,10 @@ pub struct Model {
     /// the deck's loads, reached in `k` load steps (`analysis` is that static analysis),
     /// as `mecano-rs modes --static`.
     pub modes_static: bool,
+    /// Where the deck asks for the modes: the span of its `ANALYSIS MODES n` card (the
+    /// default span when it does not), so that a refusal of the count or of the rotating
+    /// state points at it.
+    pub modes_span: Span,
     /// Output requests.
     pub output: OutputRequest,
     /// The user's beams divided into several elements (`DIVIDE`, `--refine`), by the

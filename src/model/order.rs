@@ -16,6 +16,7 @@
 //! `V + W × (x − c)`, as on a straight axis.
 
 use super::arc::Arc;
+use super::mesh::InitialIndex;
 use super::{ElementId, ElementKind, MeshError, Model, NodeId, Numbering};
 use nalgebra::Vector3;
 
@@ -37,6 +38,9 @@ impl Model {
     /// nodes, and moves the nodes of divided `ARC` beams onto their arcs. Numbers come from
     /// `numbering` (past every existing number). Called once, after the divisions.
     pub fn raise_orders(&mut self, numbering: &mut Numbering) -> Result<(), MeshError> {
+        // Linear in the nodes generated (issue 35 §1): the initial velocities and each
+        // sub-element's place on its user beam are looked up, not searched.
+        let mut index = InitialIndex::of(self);
         // Division nodes of arc beams onto the arc.
         let divided: Vec<(ElementId, [NodeId; 2], Vec<NodeId>)> = self
             .divisions
@@ -47,8 +51,15 @@ impl Model {
             if let Some(arc) = self.arc_of(*beam, ends)? {
                 let n = interior.len() + 1;
                 for (j, node) in interior.iter().enumerate() {
-                    self.move_onto(*node, &arc, (j + 1) as f64 / n as f64, ends);
+                    self.move_onto(*node, &arc, (j + 1) as f64 / n as f64, ends, &index);
                 }
+            }
+        }
+        // Sub-element → (its user beam, the beam's ends, its place k of n).
+        let mut place = std::collections::HashMap::new();
+        for (u, d) in &self.divisions {
+            for (k, e) in d.elements.iter().enumerate() {
+                place.insert(*e, (*u, d.ends, k, d.elements.len()));
             }
         }
         let ids: Vec<ElementId> = self.elements.keys().copied().collect();
@@ -63,21 +74,20 @@ impl Model {
             let (a, b, span) = (el.nodes[0], el.nodes[1], el.span);
             // The span of this element on its user beam's arc: [k/n, (k+1)/n] for
             // sub-element k of a beam divided in n, [0, 1] otherwise.
-            let (user, range) = self
-                .divisions
-                .iter()
-                .find_map(|(u, d)| {
-                    let k = d.elements.iter().position(|e| *e == id)?;
-                    let n = d.elements.len() as f64;
-                    Some(((*u, d.ends), (k as f64 / n, (k + 1) as f64 / n)))
-                })
-                .unwrap_or(((id, [a, b]), (0.0, 1.0)));
+            let (user, range) =
+                place
+                    .get(&id)
+                    .map_or(((id, [a, b]), (0.0, 1.0)), |&(u, ends, k, n)| {
+                        let n = n as f64;
+                        ((u, ends), (k as f64 / n, (k + 1) as f64 / n))
+                    });
             let params = gll_params(order);
-            let interior = self.add_axis_nodes(a, b, &params, numbering, span)?;
+            let interior =
+                self.add_axis_nodes_indexed(a, b, &params, numbering, span, &mut index)?;
             if let Some(arc) = self.arc_of(user.0, &user.1)? {
                 for (node, s) in interior.iter().zip(&params) {
                     let s_user = range.0 + (range.1 - range.0) * s;
-                    self.move_onto_between(*node, &arc, s_user, *s, [a, b]);
+                    self.move_onto_between(*node, &arc, s_user, *s, [a, b], &index);
                 }
             }
             let mut nodes = vec![a];
@@ -110,15 +120,14 @@ impl Model {
         let order_nodes = std::mem::take(&mut self.order_nodes);
         let mut generated = std::collections::HashSet::new();
         for (id, interior) in &order_nodes {
-            for n in interior {
-                self.nodes.shift_remove(n);
-                generated.insert(*n);
-            }
+            generated.extend(interior.iter().copied());
             if let Some(el) = self.elements.get_mut(id) {
                 let (a, b) = (el.nodes[0], el.nodes[el.nodes.len() - 1]);
                 el.nodes = vec![a, b];
             }
         }
+        // One pass (an IndexMap's shift_remove per node is quadratic in the mesh).
+        self.nodes.retain(|id, _| !generated.contains(id));
         self.initial.retain(|iv| !generated.contains(&iv.node));
     }
 
@@ -142,8 +151,15 @@ impl Model {
     }
 
     /// Moves a node generated on the chord `ends` at fraction `s` onto `arc` at `s`.
-    fn move_onto(&mut self, node: NodeId, arc: &Arc, s: f64, ends: &[NodeId; 2]) {
-        self.move_onto_between(node, arc, s, s, *ends);
+    fn move_onto(
+        &mut self,
+        node: NodeId,
+        arc: &Arc,
+        s: f64,
+        ends: &[NodeId; 2],
+        index: &InitialIndex,
+    ) {
+        self.move_onto_between(node, arc, s, s, *ends, index);
     }
 
     /// Moves a node generated at fraction `s_chord` of the chord between `ends` onto `arc`
@@ -155,6 +171,7 @@ impl Model {
         s_arc: f64,
         s_chord: f64,
         ends: [NodeId; 2],
+        index: &InitialIndex,
     ) {
         let (xa, xb) = (self.nodes[&ends[0]].position, self.nodes[&ends[1]].position);
         let chord: Vector3<f64> = xa + (xb - xa) * s_chord;
@@ -162,7 +179,7 @@ impl Model {
         if let Some(n) = self.nodes.get_mut(&node) {
             n.position = x;
         }
-        if let Some(iv) = self.initial.iter_mut().rev().find(|iv| iv.node == node) {
+        if let Some(iv) = index.get_mut(self, node) {
             iv.velocity += iv.angular.cross(&(x - chord));
         }
     }

@@ -40,6 +40,9 @@ pub fn deck_about(model: &Model) -> About {
 pub struct Failed {
     /// The deck or the request is at fault (not the solver).
     pub bad_input: bool,
+    /// More modes asked for than the model has (the request's count is at fault: the
+    /// command points at it).
+    pub too_many: bool,
     /// Message.
     pub message: String,
 }
@@ -47,6 +50,7 @@ pub struct Failed {
 fn bad(message: String) -> Failed {
     Failed {
         bad_input: true,
+        too_many: false,
         message,
     }
 }
@@ -54,6 +58,7 @@ fn bad(message: String) -> Failed {
 fn failed(message: String) -> Failed {
     Failed {
         bad_input: false,
+        too_many: false,
         message,
     }
 }
@@ -208,6 +213,10 @@ fn analyse_model_with(
         ModesError::Dense(d) => failed(d.to_string()),
         ModesError::Sparse(d) => failed(d.to_string()),
         ModesError::Equilibrium(d) => failed(d.to_string()),
+        e @ ModesError::TooMany { .. } => Failed {
+            too_many: true,
+            ..bad(e.to_string())
+        },
         other => bad(other.to_string()),
     })?;
     Ok((integ, a))

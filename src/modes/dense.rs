@@ -43,6 +43,11 @@ pub enum DenseError {
         "a damped or gyroscopic model with massless degrees of freedom: the first-order form needs a regular mass matrix"
     )]
     MasslessDamped,
+    /// ω²_max, the largest ratio of a stiffness to its mass, is not a finite number.
+    #[error(
+        "the ratio of stiffness to mass overflows (ω²_max is not a finite number): no eigen-solve is possible"
+    )]
+    NotFinite,
     /// The eigen-decomposition did not converge.
     #[error("the dense eigen-decomposition did not converge")]
     NoConvergence,
@@ -65,18 +70,33 @@ pub fn conservative(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<RawMode>, 
             wmax = wmax.max(k[(i, i)].abs() / m[(i, i)]);
         }
     }
+    // A ratio that overflows (a stiffness of 1e308 over a mass of 1) has no shift: no
+    // σ ≥ 1e-8 ω²_max is a number. (Also a non-finite entry of K or M.)
+    if !wmax.is_finite() || !k.iter().chain(m.iter()).all(|v| v.is_finite()) {
+        return Err(DenseError::NotFinite);
+    }
     let wmax = if wmax > 0.0 { wmax } else { 1.0 };
     // σ = 1e-8 ω²_max: far above the round-off zeros of K (ε ω²_max), so K + σM is
-    // positive definite, and small enough to cost ω² only ε σ = 1e-8 ε ω²_max.
+    // positive definite, and small enough to cost ω² only ε σ = 1e-8 ε ω²_max. Then
+    // ×100 up to 1e4 ω²_max: at most SHIFTS tries, whatever the numbers (issue 35: the
+    // loop's exit test `σ > 1e2 ω²_max` never held once 1e2 ω²_max overflowed).
+    const SHIFTS: i32 = 7;
+    let mut chol = None;
     let mut sigma = 1e-8 * wmax;
-    let chol = loop {
-        if let Some(c) = (k + m * sigma).cholesky() {
-            break c;
+    for _ in 0..SHIFTS {
+        // A shift that overflowed would put NaN (0·∞) in K + σM, which a Cholesky
+        // factorisation does not refuse.
+        if !sigma.is_finite() {
+            break;
         }
-        if sigma > 1e2 * wmax {
-            return Err(DenseError::Indefinite(sigma));
+        if let Some(c) = (k + m * sigma).cholesky() {
+            chol = Some(c);
+            break;
         }
         sigma *= 100.0;
+    }
+    let Some(chol) = chol else {
+        return Err(DenseError::Indefinite(sigma / 100.0));
     };
     let l = chol.l();
     let linv = l
@@ -200,6 +220,33 @@ mod tests {
         assert!((modes[1].omega2 - 8.0).abs() < 1e-12, "{}", modes[1].omega2);
         // Mass-normalised shapes.
         assert!((modes[1].shape.norm_squared() - 1.0).abs() < 1e-12);
+    }
+
+    /// A ratio of stiffness to mass that overflows, or a stiffness holding infinities, ends
+    /// the solve with an error (issue 35: the shift loop never ended once 1e2 ω²_max
+    /// overflowed); so does an indefinite one, after its bounded shifts.
+    #[test]
+    fn overflowing_or_indefinite_stiffness_ends_in_an_error() {
+        let m = DMatrix::identity(2, 2) * 1e-3;
+        for k in [1e308, f64::INFINITY] {
+            let k = DMatrix::from_row_slice(2, 2, &[k, -k, -k, k]);
+            assert_eq!(conservative(&k, &m).unwrap_err(), DenseError::NotFinite);
+        }
+        // ω²_max finite but 1e2 ω²_max not, and no shift makes K + σM positive: the
+        // shifts overflow to infinity (the old loop's exit test `σ > 1e2 ω²_max` compared
+        // two infinities forever); now an error after the last of them.
+        let k = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, -1e307]);
+        assert!(matches!(
+            conservative(&k, &DMatrix::identity(2, 2)),
+            Err(DenseError::Indefinite(_))
+        ));
+        // A negative stiffness on a massless direction: no shift reaches it.
+        let k = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, -1.0]);
+        let m = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 0.0]);
+        assert!(matches!(
+            conservative(&k, &m),
+            Err(DenseError::Indefinite(_))
+        ));
     }
 
     #[test]

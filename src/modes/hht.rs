@@ -60,6 +60,16 @@ pub fn amplification(p: &AlphaParams, omega_h: f64) -> Matrix3<f64> {
 
 /// The numerical damping ratio and period error of `scheme` at `Ω = ωh` (module docs).
 pub fn spectral(scheme: &Scheme, omega_h: f64) -> Spectral {
+    // Ω² not a number (an overflowed frequency): the limit Ω → ∞, the scheme's ρ∞ (the
+    // matrices below would hold infinities; the ESDIRK phase loop would never end).
+    if !(omega_h * omega_h).is_finite() {
+        return Spectral {
+            omega_h,
+            radius: scheme.rho_inf(),
+            damping: 0.0,
+            period_error: f64::INFINITY,
+        };
+    }
     match scheme {
         Scheme::Hht { .. } | Scheme::GeneralizedAlpha { .. } => {
             principal_of(&amplification(&AlphaParams::of(scheme), omega_h), omega_h)
@@ -75,6 +85,7 @@ pub fn spectral(scheme: &Scheme, omega_h: f64) -> Spectral {
             // damps. Increments of at most 0.05 and 1 % of Ω keep each phase change far
             // below π (measured: the unwrapped phase rises monotonically to 3π/2 for ESDIRK3
             // and ≈ 3.5π for ESDIRK5 as Ω → ∞).
+            // At most 100 + ln(Ω/5)/ln(1.01) < 71,500 increments for any finite Ω.
             let r = |w: f64| tab.stability(nalgebra::Complex::new(0.0, w));
             let (mut w, mut z, mut arg) = (0.0f64, r(0.0), 0.0f64);
             while w < omega_h {
@@ -219,6 +230,24 @@ pub fn compared_schemes(deck: &Scheme) -> Vec<Scheme> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An overflowed Ω (a stiffness of 1e308) gives the limit Ω → ∞ of every scheme at
+    /// once: the ESDIRK phase loop never ended on it, the α family's 3×3 inverse panicked.
+    #[test]
+    fn an_overflowed_frequency_gives_the_limit_at_once() {
+        for scheme in [
+            Scheme::Hht { alpha: -0.1 },
+            Scheme::GeneralizedAlpha { rho_inf: 0.8 },
+            Scheme::Esdirk3,
+            Scheme::Esdirk5,
+        ] {
+            for w in [f64::INFINITY, 1e200, f64::NAN] {
+                let s = spectral(&scheme, w);
+                assert_eq!(s.radius, scheme.rho_inf(), "{scheme} Ω {w}");
+                assert_eq!(s.period_error, f64::INFINITY);
+            }
+        }
+    }
 
     #[test]
     fn trapezoidal_rule_is_undamped_with_the_closed_form_period() {

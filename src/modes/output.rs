@@ -183,8 +183,8 @@ pub fn write_all(
     let shapes = shapes_csv(a, sys, nodes, states);
     let json = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
     std::fs::create_dir_all(dir)?;
-    std::fs::write(dir.join("modes.csv"), csv)?;
-    std::fs::write(dir.join("modes_shapes.csv"), shapes)?;
-    std::fs::write(dir.join("summary.json"), json + "\n")?;
+    crate::safe_file::write(&dir.join("modes.csv"), csv.as_bytes())?;
+    crate::safe_file::write(&dir.join("modes_shapes.csv"), shapes.as_bytes())?;
+    crate::safe_file::write(&dir.join("summary.json"), (json + "\n").as_bytes())?;
     Ok(())
 }

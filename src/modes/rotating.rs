@@ -64,7 +64,7 @@ pub enum FrameError {
     NoDrivenHinge,
     /// A second driver (or a PRESCRIBED motion, or a driven PRISMATIC).
     #[error(
-        "element {element}: a second driver (or a PRESCRIBED / driven PRISMATIC motion): the rotating frame follows exactly one driven HINGE"
+        "{element}: a second driver (or a PRESCRIBED / driven PRISMATIC motion): the rotating frame follows exactly one driven HINGE"
     )]
     OtherDriver {
         /// The element.
@@ -74,7 +74,7 @@ pub enum FrameError {
     },
     /// The hinge's first node is not fully fixed: its axis would not be inertial.
     #[error(
-        "element {element}: the driven hinge's first node must be the fixed ground (FIX ALL) for its axis to be inertial"
+        "{element}: the driven hinge's first node must be the fixed ground (FIX ALL) for its axis to be inertial"
     )]
     NotGrounded {
         /// The hinge.
@@ -84,7 +84,7 @@ pub enum FrameError {
     },
     /// The speed is not constant at the linearisation time.
     #[error(
-        "element {element}: the driven speed is not constant at t = {t} s (a ḟ = {speed:e} rad/s, a f̈ = {accel:e} rad/s²): no steady rotation"
+        "{element}: the driven speed is not constant at t = {t} s (a ḟ = {speed:e} rad/s, a f̈ = {accel:e} rad/s²): no steady rotation"
     )]
     NotConstant {
         /// The hinge.
@@ -165,14 +165,14 @@ impl Frame {
         for (id, n) in &model.nodes {
             if Some(*id) != ground_id && n.fixed.iter().any(|f| *f) {
                 return Err(FrameError::NotSteady(format!(
-                    "node {id} has fixed degrees of freedom (held in the inertial frame)"
+                    "{id} has fixed degrees of freedom (held in the inertial frame)"
                 )));
             }
         }
         for (id, el) in &model.elements {
             if *id != frame.element && ground_id.is_some_and(|g| el.nodes.contains(&g)) {
                 return Err(FrameError::NotSteady(format!(
-                    "element {id} is attached to the ground node, which does not turn"
+                    "{id} is attached to the ground node, which does not turn"
                 )));
             }
         }

@@ -63,7 +63,8 @@ pub fn write_series(
     nodes: &[NodeState],
     a: &ModalAnalysis,
 ) -> std::io::Result<Vec<String>> {
-    std::fs::create_dir_all(dir.join("vtk"))?;
+    std::fs::create_dir_all(dir)?;
+    crate::safe_file::real_dir(&dir.join("vtk"))?;
     let cells = line_cells(model);
     let mut pvds = Vec::new();
     for (k, m) in a.modes.iter().enumerate() {
@@ -95,7 +96,7 @@ pub fn write_series(
             }
             let text = frame_xml(&cells, [&pts, &disp, &rot, &vel, &om])?;
             let rel = format!("vtk/mode_{:03}_{j:02}.vtu", k + 1);
-            std::fs::write(dir.join(&rel), text)?;
+            crate::safe_file::write(&dir.join(&rel), text.as_bytes())?;
             let t = match m.period() {
                 Some(p) => p * j as f64 / FRAMES as f64,
                 None => j as f64 / FRAMES as f64,

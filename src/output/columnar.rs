@@ -183,7 +183,17 @@ fn header(b: &[u8]) -> Result<Header, String> {
 fn open(dir: &Path) -> Option<Result<(File, Header), ReadError>> {
     let path = dir.join(FILE_NAME);
     let file_s = path.display().to_string();
-    let f = File::open(&path).ok()?;
+    // A FIFO or a device under the name is not waited on (crate::safe_file).
+    let f = match crate::safe_file::open_regular(&path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return None,
+        Err(e) => {
+            return Some(Err(ReadError::Io {
+                file: file_s,
+                source: e,
+            }));
+        }
+    };
     let io = |source| ReadError::Io {
         file: file_s.clone(),
         source,

@@ -403,8 +403,7 @@ impl Writer {
         );
         let text = serde_json::to_string_pretty(&v).unwrap_or_else(|_| "{}".into());
         let tmp = self.dir.join("summary.json.tmp");
-        fs::write(&tmp, text)?;
-        fs::rename(tmp, self.dir.join("summary.json"))
+        crate::safe_file::write_atomic(&tmp, &self.dir.join("summary.json"), text.as_bytes())
     }
 
     /// Writes the final state if it was skipped by `EVERY` (not for an interrupted run:

@@ -22,7 +22,6 @@
 //! block, so a file cut by a failure holds whole records, all counted. A restart cuts the
 //! file back to its checkpointed length and sets the count from it.
 
-use std::fs::{File, OpenOptions};
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
@@ -225,7 +224,7 @@ impl Columnar {
     pub(crate) fn create(dir: &Path, title: &str, groups: &[Group]) -> io::Result<Self> {
         let path = dir.join(FILE_NAME);
         let layout = layout(title, groups);
-        let mut f = File::create(&path)?;
+        let mut f = crate::safe_file::create(&path)?;
         f.write_all(&layout.prefix)?;
         Ok(Self::with(path, layout, 0))
     }
@@ -255,7 +254,7 @@ impl Columnar {
                 format!("{}: {why}", path.display()),
             )
         };
-        let mut f = OpenOptions::new().read(true).write(true).open(&path)?;
+        let mut f = crate::safe_file::read_write(&path)?;
         let actual = f.metadata()?.len();
         if actual < len || len < layout.rec_begin {
             return Err(bad(format!(
@@ -307,7 +306,7 @@ impl Columnar {
         if self.pending.is_empty() {
             return Ok(());
         }
-        let f = OpenOptions::new().write(true).open(&self.path)?;
+        let f = crate::safe_file::write_existing(&self.path)?;
         let at = self.layout.rec_begin + self.numrecs * self.layout.rec_size;
         f.write_all_at(&self.pending, at)?;
         self.numrecs += (self.pending.len() as u64) / self.layout.rec_size;
@@ -318,7 +317,7 @@ impl Columnar {
     /// Writes the buffered records and waits until the file is on the disk.
     pub(crate) fn sync(&mut self) -> io::Result<()> {
         self.flush()?;
-        OpenOptions::new().write(true).open(&self.path)?.sync_data()
+        crate::safe_file::write_existing(&self.path)?.sync_data()
     }
 
     /// Length of the file once the buffered records are written, bytes.

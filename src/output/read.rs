@@ -41,8 +41,8 @@ pub fn read_numeric(path: &Path, opt: ReadOptions) -> Result<NumericCsv, String>
     let trim = |s: &str| if opt.trim { s.trim() } else { s }.to_string();
     let mut r = csv::ReaderBuilder::new()
         .has_headers(true)
-        .from_path(path)
-        .map_err(|e| e.to_string())?;
+        // A regular file only (a FIFO under a history's name is not waited on).
+        .from_reader(crate::safe_file::open_regular(path).map_err(|e| e.to_string())?);
     let header: Vec<String> = r
         .headers()
         .map_err(|e| e.to_string())?

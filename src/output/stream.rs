@@ -14,7 +14,7 @@
 //! a memory budget shared by all its streams ([`block_size`]), so the buffers of a large
 //! selection stay bounded and never grow (no allocation per row).
 
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::{self, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -63,7 +63,7 @@ impl Stream {
 
     /// Creates (truncates) the file and writes the header row with the first block.
     pub(crate) fn create(path: &Path, header: &str, block: usize) -> io::Result<Self> {
-        File::create(path)?;
+        crate::safe_file::create(path)?;
         let mut s = Stream {
             path: path.to_path_buf(),
             block,
@@ -82,11 +82,7 @@ impl Stream {
     /// follows them was written after the checkpoint, and is cut). The file must be at
     /// least `len` bytes long and begin with the header.
     pub(crate) fn reopen(path: &Path, header: &str, len: u64, block: usize) -> io::Result<Self> {
-        let mut file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .open(path)
-            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+        let mut file = crate::safe_file::read_write(path)?;
         let actual = file.metadata()?.len();
         if actual < len {
             return Err(io::Error::new(
@@ -150,10 +146,7 @@ impl Stream {
     }
 
     fn open(&self) -> io::Result<File> {
-        OpenOptions::new()
-            .append(true)
-            .open(&self.path)
-            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", self.path.display())))
+        crate::safe_file::append(&self.path)
     }
 
     /// Writes the buffered rows to the file (opened, appended to, closed).

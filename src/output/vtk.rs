@@ -54,7 +54,8 @@ impl VtkWriter {
     }
 
     fn create_in(dir: &Path, model: &Model, _sys: &System) -> io::Result<Self> {
-        fs::create_dir_all(dir.join("vtk"))?;
+        fs::create_dir_all(dir)?;
+        crate::safe_file::real_dir(&dir.join("vtk"))?;
         let cells = line_cells(model);
         let w = VtkWriter {
             dir: dir.to_path_buf(),
@@ -88,7 +89,7 @@ impl VtkWriter {
         }
         let s = frame_xml(&self.cells, [&pts, &disp, &rot, &vel, &omega])?;
         let rel = format!("vtk/frame_{:06}.vtu", self.frames.len());
-        fs::write(self.dir.join(&rel), s)?;
+        crate::safe_file::write(&self.dir.join(&rel), s.as_bytes())?;
         self.frames.push((integ.t, rel));
         self.last_step = Some(snap.step);
         if self.frames.len().is_multiple_of(PVD_EVERY) {
@@ -253,8 +254,7 @@ pub fn write_collection(path: &Path, frames: &[(f64, String)]) -> io::Result<()>
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
     let tmp = path.with_extension("pvd.tmp");
-    fs::write(&tmp, s)?;
-    fs::rename(tmp, path)
+    crate::safe_file::write_atomic(&tmp, path, s.as_bytes())
 }
 
 /// Forwards every state and progress report to several observers, in order (the first

@@ -7,10 +7,13 @@ use super::*;
 /// The deck named in `dir/summary.json`.
 pub fn deck_of(dir: &Path) -> Result<PathBuf, PlotError> {
     let file = dir.join("summary.json");
-    let text = std::fs::read_to_string(&file).map_err(|_| PlotError::NoFile {
-        file: file.clone(),
-        hint: "not a run's output directory? give the deck with --deck".into(),
-    })?;
+    let text =
+        crate::safe_file::read_text(&file, crate::safe_file::MAX_TEXT_BYTES).map_err(|_| {
+            PlotError::NoFile {
+                file: file.clone(),
+                hint: "not a run's output directory? give the deck with --deck".into(),
+            }
+        })?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| PlotError::Read {
         file: file.clone(),
         msg: e.to_string(),
@@ -26,7 +29,7 @@ pub fn deck_of(dir: &Path) -> Result<PathBuf, PlotError> {
 
 /// The `--refine` factor recorded in `dir/summary.json` (1 when absent).
 pub fn refine_of(dir: &Path) -> u32 {
-    std::fs::read_to_string(dir.join("summary.json"))
+    crate::safe_file::read_text(&dir.join("summary.json"), crate::safe_file::MAX_TEXT_BYTES)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
         .and_then(|v| v.get("refine").and_then(|r| r.as_u64()))

@@ -42,10 +42,13 @@ pub struct ModesArgs {
 /// One row of modes.csv: number, kind, natural frequency (Hz).
 fn read_modes(dir: &Path) -> Result<Vec<(usize, String, f64)>, PlotError> {
     let file = dir.join("modes.csv");
-    let text = std::fs::read_to_string(&file).map_err(|_| PlotError::NoFile {
-        file: file.clone(),
-        hint: "run mecano-rs modes DECK -o DIR first".into(),
-    })?;
+    let text =
+        crate::safe_file::read_text(&file, crate::safe_file::MAX_TEXT_BYTES).map_err(|_| {
+            PlotError::NoFile {
+                file: file.clone(),
+                hint: "run mecano-rs modes DECK -o DIR first".into(),
+            }
+        })?;
     let bad = |msg: &str| PlotError::Read {
         file: file.clone(),
         msg: msg.to_string(),

@@ -301,6 +301,22 @@ pub fn prepare(model: &Model) -> Result<Integrator, BuildError> {
     Ok(integ)
 }
 
+/// How far above the smallest step (`MINSTEP`) a step still counts as the smallest, for
+/// the refusals of the error and event controls: the run loop stretches a step by up to
+/// 1e-3 of itself to land on a breakpoint or the end (never a sliver of a step after it),
+/// so a retry at the smallest step may come back that much longer. With a tolerance of
+/// 1e-9 such a step was refused again, retried at the smallest step, stretched again — for
+/// ever (the fuzzer's case 35:8517: an adaptive run 1e-8 s short of its end, deaf to
+/// Ctrl-C since no step was ever accepted).
+pub(crate) const FLOOR_SLACK: f64 = 1e-3;
+
+/// Most consecutive refused attempts of one step. Each refusal shortens the step by at
+/// least 0.1 % (an event's retry is at most 0.999 h, the error control's at most 0.9 h)
+/// down to `MINSTEP`, where no refusal is made, and `END/MINSTEP ≤ 1e12` (grammar.md), so
+/// ln(1e12)/ln(1/0.999) ≈ 27,600 refusals is the most a step can take: this bound is a
+/// guard that a broken control cannot turn into a loop without end.
+pub(crate) const MAX_REFUSALS: u32 = 100_000;
+
 /// The adaptive step after `h` when the error estimate proposes `proposal`: the largest
 /// rung `h₀·2^(k/4)` not above the proposal; a larger step only if that is at least two
 /// rungs (×1.41) above `h`, else `h` is kept.

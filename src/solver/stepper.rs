@@ -51,6 +51,9 @@ pub struct Stepper {
     h: f64,
     good: u32,
     retry: Option<f64>,
+    /// Consecutive refused attempts (reset at each accepted step), bounded by
+    /// [`super::MAX_REFUSALS`].
+    refusals: u32,
     pause_due: bool,
     cpu0: f64,
     start: Instant,
@@ -146,6 +149,7 @@ impl Stepper {
             retry: ctl.retry,
             // Pauses come after the initial state and after each accepted step (not after a
             // refused attempt, nor at once after a restart: that state was the last pause's).
+            refusals: 0,
             pause_due: resume.is_none(),
             cpu0,
             start,
@@ -319,6 +323,7 @@ impl Stepper {
         }
         match integ.try_step(h_try) {
             Ok(_) => {
+                self.refusals = 0;
                 integ.stats.min_step = integ.stats.min_step.min(h_try);
                 integ.stats.max_step = integ.stats.max_step.max(h_try);
                 let v = integ.constraint_violation();
@@ -364,15 +369,25 @@ impl Stepper {
                 self.interrupted = Some(Interruption::WithinStep);
                 Ok(false)
             }
-            Err(Failure {
-                reason: FailureReason::StepRefused(h_ok),
-                residual_history,
-                ..
-            }) => {
-                // An element (e.g. a contact at an impact) asks for a shorter step.
-                integ.recycle_history(residual_history);
+            Err(
+                f @ Failure {
+                    reason: FailureReason::StepRefused(_),
+                    ..
+                },
+            ) => {
+                // An element (e.g. a contact at an impact) or the error control asks for a
+                // shorter step.
+                let FailureReason::StepRefused(h_ok) = f.reason else {
+                    unreachable!("matched above")
+                };
                 integ.stats.rejected_steps += 1;
-                self.retry = Some(h_ok.max(hmin).min(h_try));
+                self.refusals += 1;
+                if self.refusals > super::MAX_REFUSALS {
+                    self.failure = Some(f);
+                } else {
+                    integ.recycle_history(f.residual_history);
+                    self.retry = Some(h_ok.max(hmin).min(h_try));
+                }
                 Ok(false)
             }
             Err(f) => {

@@ -85,8 +85,8 @@ pub struct SweepArgs {
     /// The sweep's output directory (default: the plan's `out`, else out/sweeps/<plan name>).
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Cases run at once (default: all cores).
-    #[arg(short = 'j', long, value_name = "N")]
+    /// Cases run at once, at least 1 (default: all cores).
+    #[arg(short = 'j', long, value_name = "N", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     pub jobs: Option<usize>,
     /// Print the cases (index and parameter values), run nothing.
     #[arg(long)]
@@ -150,6 +150,32 @@ pub fn parse_cases(spec: &str, n: usize) -> Result<Vec<usize>, SweepError> {
     Ok(out)
 }
 
+/// Why the sweep's output directory `dir` cannot be used (a file, `/dev/null`, a path
+/// below a file), as a run says it; `None` when it is a directory or can be created.
+fn unusable_out(dir: &std::path::Path) -> Option<String> {
+    if dir.exists() && !dir.is_dir() {
+        return Some(format!(
+            "the output path {} exists and is not a directory",
+            dir.display()
+        ));
+    }
+    // The nearest existing ancestor must be a directory (`out/file/sub`: below a file).
+    let mut p = dir.parent();
+    while let Some(a) = p.filter(|a| !a.as_os_str().is_empty()) {
+        if a.exists() {
+            return (!a.is_dir()).then(|| {
+                format!(
+                    "the output directory {} cannot be used: {} is not a directory",
+                    dir.display(),
+                    a.display()
+                )
+            });
+        }
+        p = a.parent();
+    }
+    None
+}
+
 fn fmt_values(plan: &Plan, i: usize) -> String {
     let mut b = ryu::Buffer::new();
     plan.params
@@ -179,6 +205,14 @@ pub fn run(args: &SweepArgs) -> u8 {
             plan.path.display()
         );
         return code;
+    }
+    // An output path that cannot be a directory is bad input, as for a run (exit 2, before
+    // anything is run or written).
+    if !args.list
+        && let Some(why) = unusable_out(&plan.out)
+    {
+        eprintln!("error: plan {}: {why}", plan.path.display());
+        return EXIT_BAD_INPUT;
     }
     let mut out = std::io::stdout().lock();
     if args.list {
@@ -283,7 +317,11 @@ pub fn run(args: &SweepArgs) -> u8 {
                 let _ = write!(
                     out,
                     "{}",
-                    std::fs::read_to_string(plan.out.join("statistics.csv")).unwrap_or_default()
+                    crate::safe_file::read_text(
+                        &plan.out.join("statistics.csv"),
+                        crate::safe_file::MAX_TEXT_BYTES
+                    )
+                    .unwrap_or_default()
                 );
             }
             // Issue 28 §5: a sweep whose cases failed (or whose quantities are missing)

@@ -206,7 +206,8 @@ fn bad(path: &Path, msg: impl Into<String>) -> SweepError {
 impl Plan {
     /// Reads and validates a plan; `out` overrides the plan's output directory.
     pub fn load(path: &Path, out: Option<&Path>) -> Result<Plan, SweepError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SweepError::Io {
+        // Bounded as a deck is (a plan read from a device or a pipe ends).
+        let text = crate::deck::read_text(path).map_err(|e| SweepError::Io {
             path: path.to_path_buf(),
             reason: e.to_string(),
         })?;
@@ -218,8 +219,8 @@ impl Plan {
         let f: PlanFile = toml::from_str(text).map_err(|e| bad(path, e.to_string()))?;
         let dir = path.parent().unwrap_or(Path::new(""));
         let deck = dir.join(&f.deck);
-        let deck_hash = std::fs::read(&deck)
-            .map(|b| crate::checkpoint::sha256_hex(&b))
+        let deck_hash = crate::deck::read_source(&deck)
+            .map(|t| crate::checkpoint::sha256_hex(t.as_bytes()))
             .unwrap_or_default();
         let stem = path
             .file_stem()

@@ -79,7 +79,9 @@ pub struct CaseRecord {
 /// the case's files (no rerun) and the record rewritten.
 pub fn finished(plan: &Plan, i: usize) -> Option<CaseRecord> {
     let dir = plan.case_dir(i);
-    let text = std::fs::read_to_string(dir.join("case.json")).ok()?;
+    let text =
+        crate::safe_file::read_text(&dir.join("case.json"), crate::safe_file::MAX_TEXT_BYTES)
+            .ok()?;
     let mut rec: CaseRecord = serde_json::from_str(&text).ok()?;
     if rec.values != plan.cases[i] || rec.deck_hash != plan.deck_hash {
         return None;
@@ -106,10 +108,11 @@ fn quantify(plan: &Plan, dir: &Path, rec: &mut CaseRecord) {
     if !matches!(rec.status, Status::Ok | Status::Failed) {
         return;
     }
-    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or_default();
+    let summary: serde_json::Value =
+        crate::safe_file::read_text(&dir.join("summary.json"), crate::safe_file::MAX_TEXT_BYTES)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default();
     for (k, q) in plan.quantities.iter().enumerate() {
         match q.eval(dir, &summary) {
             Ok(v) => rec.quantities[k] = v,
@@ -197,15 +200,20 @@ fn run_fresh(
         reason: e.to_string(),
     })?;
     let overrides = plan.overrides(i);
-    let text = std::fs::read_to_string(&plan.deck).unwrap_or_default();
-    let result = match crate::deck::load_deck_with(&plan.deck, &overrides) {
+    // Read once (bounded: a regular file or a pipe): the text parsed is the text named.
+    let read = crate::deck::read_source(&plan.deck);
+    let text = read.as_deref().unwrap_or_default().to_string();
+    let parsed = read.and_then(|t| {
+        crate::deck::parse_deck_with(&t, &plan.deck.display().to_string(), &overrides)
+    });
+    let result = match parsed {
         Err(errs) => Err((app::EXIT_BAD_INPUT, deck_errors_text(&errs))),
         // `ANALYSIS MODES n`: the case is a modal analysis (its summary.json holds the
         // modes the `mode` quantities read), as `mecano-rs DECK` makes it.
         Ok(model) if model.modes.is_some() => {
             let n = model.modes.unwrap_or(1) as usize;
             let about = crate::modes::about::deck_about(&model);
-            match app::modes::run_loaded(&plan.deck, &model, about, n, dir, true) {
+            match app::modes::run_loaded(&plan.deck, &text, &model, about, n, dir, true, false) {
                 app::EXIT_OK => Ok(crate::solver::RunReport {
                     stats: Default::default(),
                     time: 0.0,

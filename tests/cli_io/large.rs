@@ -225,13 +225,14 @@ fn output_that_cannot_be_opened_stops_before_the_first_step_with_exit_2() {
         text(&o)
     );
     // The directory is usable but a history file cannot be created (a directory holds its
-    // name): the writer's own failure, before the first step.
+    // name): refused when the directory is claimed (issue 35 §3: a name the run writes
+    // held by anything but a regular file of the previous run), before the first step.
     let out = d.join("out2");
     std::fs::create_dir_all(out.join("node_2.csv")).unwrap();
     let o = run(&deck, &out, None);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
-        text(&o).contains("cannot open the output"),
+        text(&o).contains("node_2.csv is a directory"),
         "the cause is named: {}",
         text(&o)
     );

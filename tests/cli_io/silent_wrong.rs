@@ -24,16 +24,24 @@ fn pendulum(from: &str, to: &str, end: &str) -> String {
 /// Huge loads used to pass the Newton test with zero iterations: the reference force was
 /// `|load|`, whose norm overflowed to infinity (1e200² > f64::MAX), so every relative
 /// residual was 0 (exit 0, "complete", the node never felt the load, energy balance
-/// error 1.0). Each must now stop with a diagnosis (the run cannot be resolved at any
-/// step: its state becomes non-finite, or Newton fails).
+/// error 1.0). A load beyond 1e100 is now refused as input (issue 35 §1: its squared norm
+/// would overflow); one within it but far beyond what the model carries must stop with a
+/// diagnosis (the run cannot be resolved at any step: its state becomes non-finite, or
+/// Newton fails).
 #[test]
 fn huge_loads_end_in_a_diagnosis_not_a_zero_iteration_success() {
+    for to in ["MOMENT 2  0 0 -1e200", "MOMENT 2  0 0 -1e308"] {
+        let e = parse_deck(&pendulum("MOMENT 2  0 0 -1000", to, "0.01"), "huge.dat")
+            .expect_err(to)
+            .to_string();
+        assert!(e.contains("out of range"), "`{to}`: {e}");
+    }
     for (from, to) in [
-        ("MOMENT 2  0 0 -1000", "MOMENT 2  0 0 -1e200"),
-        ("MOMENT 2  0 0 -1000", "MOMENT 2  0 0 -1e308"),
+        ("MOMENT 2  0 0 -1000", "MOMENT 2  0 0 -1e60"),
+        ("MOMENT 2  0 0 -1000", "MOMENT 2  0 0 -1e100"),
         (
             "MOMENT 2  0 0 -1000  FUNCTION 1",
-            "MOMENT 2  0 0 -1000  FUNCTION 1\n  FORCE 12 0 -1e200 0",
+            "MOMENT 2  0 0 -1000  FUNCTION 1\n  FORCE 12 0 -1e100 0",
         ),
     ] {
         let model = parse_deck(&pendulum(from, to, "0.01"), "huge.dat").expect("the deck parses");
@@ -147,15 +155,16 @@ fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 
-/// Every failure writes the same record: `I2 1e308` fails before the first step (its
-/// matrix cannot be factored) and a huge force fails in the first step; both exit 1 with a
-/// summary holding the failure, the stop and the counters, and CSVs with their header.
+/// Every failure writes the same record: `I2 1e60` fails before the first step (its
+/// matrix cannot be factored: the bars' stiffness swamps their mass) and a huge moment
+/// fails in the first step; both exit 1 with a summary holding the failure, the stop and
+/// the counters, and CSVs with their header. (1e308 in either is refused as input now.)
 #[test]
 fn every_failure_writes_the_complete_record() {
     let d = tmp("record");
     for (name, from, to) in [
-        ("section", "I2 8.3e-8", "I2 1e308"),
-        ("force", "MOMENT 2  0 0 -1000", "MOMENT 2  0 0 -1e308"),
+        ("section", "I2 8.3e-8", "I2 1e60"),
+        ("force", "MOMENT 2  0 0 -1000", "MOMENT 2  0 0 -1e100"),
     ] {
         let deck = d.join(format!("{name}.dat"));
         std::fs::write(&deck, pendulum(from, to, "0.01")).unwrap();

@@ -488,3 +488,41 @@ fn sweep_refuses_unknown_names_and_reports_failed_cases() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// ------------------------------------------------------------------------- issue 35 §1
+
+/// A run's loops end within bounds the deck states: Newton within MAXIT ≤ 1000 iterations
+/// per step, the step loop only while its time can still advance (END/MINSTEP ≤ 1e12, so
+/// that `t + h` never rounds to `t`); and no real number beyond 1e100 (or a non-zero one
+/// below 1e-100) enters the model. Each refusal is at its field.
+#[test]
+fn loop_bounds_and_magnitudes_are_refused_at_their_field() {
+    let base = "TITLE t\nNODES\n 1 0 0 0\nELEMENTS\n 1 MASS 1 M 1\nANALYSIS DYNAMIC STEP 1e-3 END 2e-3\nEND\n";
+    assert!(parse_deck(base, "d.dat").is_ok());
+    for (from, to, says) in [
+        ("END 2e-3", "END 2e-3 MAXIT 4294967295", "MAXIT"),
+        ("END 2e-3", "END 2e-3 MAXIT 1001", "MAXIT"),
+        ("END 2e-3", "END 1e10", "END/MINSTEP"),
+        ("END 2e-3", "END 1 MINSTEP 1e-13", "END/MINSTEP"),
+        ("M 1", "M 1e-101", "1e-100 to 1e100"),
+        ("M 1", "M 1e101", "1e-100 to 1e100"),
+        ("1 0 0 0", "1 0 1e308 0", "1e-100 to 1e100"),
+        ("M 1", "M 2^400", "1e-100 to 1e100"),
+    ] {
+        let src = base.replace(from, to);
+        let (kind, (line, _), msg) = first_error(&src);
+        assert!(matches!(kind, K::OutOfRange { .. }), "`{to}`: {msg}");
+        assert!(msg.contains(says), "`{to}`: {msg}");
+        let want = src.lines().position(|l| l.contains(to)).unwrap() + 1;
+        assert_eq!(line, want, "`{to}`: {msg}");
+    }
+    // At the bounds: accepted.
+    for (from, to) in [
+        ("END 2e-3", "END 2e-3 MAXIT 1000"),
+        ("M 1", "M 1e100"),
+        ("M 1", "M 1e-100"),
+        ("END 2e-3", "END 1 MINSTEP 1e-12"),
+    ] {
+        parse_deck(&base.replace(from, to), "d.dat").unwrap_or_else(|e| panic!("`{to}`: {e}"));
+    }
+}

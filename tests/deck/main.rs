@@ -9,6 +9,7 @@ mod deck_errors;
 mod deck_props;
 mod deck_roundtrip;
 mod functions;
+mod fuzz_regressions;
 mod grammar_doc;
 mod hostile;
 mod hostile_corpus;

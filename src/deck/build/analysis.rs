@@ -4,6 +4,12 @@ use super::cursor::*;
 use super::*;
 use crate::model::Scheme;
 
+/// Most Newton iterations a step may take (`MAXIT`).
+pub const MAX_NEWTON_ITERATIONS: u32 = 1000;
+/// Largest ratio of the end time to the smallest step: 1e12 keeps `t + 1e-3·MINSTEP > t`
+/// at `t = END` with a margin of 4 (2⁻⁵² · 1e15 ≈ 0.22).
+pub const MAX_END_OVER_MINSTEP: f64 = 1e12;
+
 impl Builder<'_> {
     // ---------------------------------------------------------------- LOADS
     pub(super) fn load(&mut self, card: &Card<'_>) -> R<()> {
@@ -143,6 +149,7 @@ impl Builder<'_> {
             self.modes = Some(n);
             self.modes_rotating = about == Some("ROTATING");
             self.modes_static = about == Some("STATIC");
+            self.modes_span = span;
             return Ok(());
         }
         let kws: &[&'static str] = if kind == "DYNAMIC" {
@@ -183,7 +190,13 @@ impl Builder<'_> {
                     )?)
                 }
                 "STEP" => step = Some(c.number("STEP (time step)")?),
-                "END" => end = Some(c.number_in("END (end time)", "> 0 s", pos)?),
+                "END" => {
+                    let (v, s, t) = c.number("END (end time)")?;
+                    if !pos(v) {
+                        return Err(out_of_range("END (end time)", t, "> 0 s", s));
+                    }
+                    end = Some((v, s, t));
+                }
                 "MINSTEP" => min = Some(c.number("MINSTEP (smallest step)")?),
                 "MAXSTEP" => max = Some(c.number("MAXSTEP (largest step)")?),
                 "ADAPTIVE" => adaptive = Some(ks),
@@ -204,9 +217,13 @@ impl Builder<'_> {
                 "TOL" => newton.tol_residual = c.number_in("TOL", "> 0", pos)?,
                 "TOLINC" => newton.tol_increment = c.number_in("TOLINC", "> 0", pos)?,
                 "MAXIT" => {
+                    let t = c.peek();
                     let (n, s) = c.uint("MAXIT")?;
-                    if n < 1 {
-                        return Err(out_of_range("MAXIT", "0", ">= 1", s));
+                    // A step's Newton loop ends within MAXIT iterations: bounded, so that a
+                    // stagnating step cannot hold a run (and its first Ctrl-C) for ever.
+                    if !(1..=MAX_NEWTON_ITERATIONS).contains(&n) {
+                        let range = format!("1 to {MAX_NEWTON_ITERATIONS}");
+                        return Err(out_of_range("MAXIT", t.map_or("", |t| t.text), &range, s));
                     }
                     newton.max_iterations = n;
                 }
@@ -244,7 +261,7 @@ impl Builder<'_> {
             if h <= 0.0 {
                 return Err(out_of_range("STEP (time step)", ht, "> 0 s", hs));
             }
-            let end = end.ok_or_else(|| miss("END <end time>"))?;
+            let (end, end_span, end_text) = end.ok_or_else(|| miss("END <end time>"))?;
             let min_step = match min {
                 None => h / 1024.0,
                 Some((v, s, t)) if v <= 0.0 || v > h => {
@@ -252,6 +269,17 @@ impl Builder<'_> {
                 }
                 Some((v, _, _)) => v,
             };
+            // The run's time t is a sum of steps: it must still resolve a thousandth of
+            // the smallest step at the end (the step loop lands on breakpoints and the grid
+            // within 1e-3 h), else t + h rounds to t and the run cannot advance.
+            if end / min_step > MAX_END_OVER_MINSTEP {
+                let found = format!("{end_text} (END/MINSTEP = {:.3e})", end / min_step);
+                let range = format!(
+                    "END/MINSTEP <= {MAX_END_OVER_MINSTEP:e} (MINSTEP is STEP/1024 by default): \
+                     beyond, the time t + h rounds to t in double precision"
+                );
+                return Err(out_of_range("END (end time)", &found, &range, end_span));
+            }
             let max_step = match max {
                 None => h,
                 Some((v, s, t)) if v < h => {

@@ -55,6 +55,19 @@ impl<'t, 'a> Cursor<'t, 'a> {
             return Err((**e).clone());
         }
         match t.number {
+            Some(v) if v.is_finite() && !crate::deck::limits::magnitude_ok(v) => {
+                let found = if super::super::expr::looks_like_expression(t.text) {
+                    format!("{} = {v:?}", t.text)
+                } else {
+                    t.text.to_string()
+                };
+                Err(out_of_range(
+                    what,
+                    &found,
+                    crate::deck::limits::MAGNITUDE_RANGE,
+                    t.span,
+                ))
+            }
             Some(v) if v.is_finite() => Ok((v, t.span, t.text)),
             Some(_) => Err(DeckError::new(
                 K::NonFinite {

@@ -26,6 +26,13 @@ impl Builder<'_> {
                 ));
             }
             generation_size(id, l, Span::new(id_span.start, ls.end))?;
+            self.fits(
+                0,
+                u64::from(l - id) + 1,
+                id,
+                l,
+                Span::new(id_span.start, ls.end),
+            )?;
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }

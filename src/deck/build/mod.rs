@@ -61,6 +61,8 @@ struct Builder<'s> {
     modes_rotating: bool,
     /// `ANALYSIS MODES n STATIC`.
     modes_static: bool,
+    /// The `ANALYSIS MODES` card.
+    modes_span: Span,
     output: Option<(OutputRequest, Span)>,
     /// Beams to divide (`DIVIDE n`, n > 1), in deck order, with their cards' spans.
     divide: Vec<(ElementId, u32, Span)>,
@@ -70,6 +72,9 @@ struct Builder<'s> {
     drives: IndexMap<ElementId, crate::model::Drive>,
     /// The parameters in force (for the expressions of `t` of EXPR functions).
     parameters: IndexMap<String, f64>,
+    /// Free nodal degrees of freedom of the nodes so far (the model's unknowns, for the
+    /// memory a generation would take: [`Builder::fits`]).
+    free_dofs: u64,
 }
 
 impl<'s> Builder<'s> {
@@ -122,6 +127,28 @@ impl<'s> Builder<'s> {
     }
 }
 
+impl Builder<'_> {
+    /// Whether `nodes` more free nodes and `elements` more elements fit in the memory the
+    /// process may take (model::budget), checked before a generation (`a TO b`) makes
+    /// them; else a located error with the figure.
+    fn fits(&self, nodes: u64, elements: u64, first: u32, last: u32, span: Span) -> R<()> {
+        let f = crate::model::budget::Footprint {
+            nodes: self.nodes.len() as u64 + nodes,
+            elements: self.elements.len() as u64 + elements,
+            unknowns: self.free_dofs + 6 * nodes,
+        };
+        crate::model::budget::check(f, "the model with this generation").map_err(|e| {
+            DeckError::new(
+                K::ModelTooLarge {
+                    request: format!("{first} TO {last}"),
+                    reason: e.to_string(),
+                },
+                span,
+            )
+        })
+    }
+}
+
 fn conflict(first: &str, second: &str, ctx: &str, span: Span) -> DeckError {
     DeckError::new(
         K::Conflict {
@@ -158,11 +185,13 @@ pub(crate) fn build_model(
         modes: None,
         modes_rotating: false,
         modes_static: false,
+        modes_span: Span::default(),
         output: None,
         divide: Vec::new(),
         hinge_refs: Vec::new(),
         drives: IndexMap::new(),
         parameters,
+        free_dofs: 0,
     };
     let of = |s: Section| cards.iter().filter(move |c| c.section == s);
     // Definitions first (in dependency order), references after: a deck may list its
@@ -245,28 +274,34 @@ pub(crate) fn build_model(
         modes: b.modes,
         modes_rotating: b.modes_rotating,
         modes_static: b.modes_static,
+        modes_span: b.modes_span,
         output: b.output.map(|o| o.0).unwrap_or_default(),
         divisions: IndexMap::new(),
         parameters: b.parameters,
         order_nodes: IndexMap::new(),
         drives: b.drives,
     };
-    // Generated numbers start past every user number: divide once all are known.
-    let mut numbering = crate::model::Numbering::after(&model);
-    for (beam, n, span) in b.divide {
-        if let Err(e) = model.divide_beam(beam, n, &mut numbering) {
-            let reason = e.to_string();
-            let err = DeckError::new(
-                K::BadGeneration {
-                    first: beam.0,
-                    last: beam.0,
-                    reason,
-                },
-                span,
-            );
-            return Err(vec![err]);
-        }
+    // Generated numbers start past every user number: divide once all are known, and
+    // once the model they make is known to fit in memory (model::budget; located at the
+    // largest DIVIDE).
+    let list: Vec<(ElementId, u32)> = b.divide.iter().map(|(e, n, _)| (*e, *n)).collect();
+    if let Err((i, e)) = model.divide_each(&list) {
+        let (beam, n, span) = b.divide[i];
+        let kind = match e {
+            e @ (crate::model::MeshError::TooLarge(_)
+            | crate::model::MeshError::OutOfMemory { .. }) => K::ModelTooLarge {
+                request: format!("DIVIDE {n}"),
+                reason: e.to_string(),
+            },
+            e => K::BadGeneration {
+                first: beam.0,
+                last: beam.0,
+                reason: e.to_string(),
+            },
+        };
+        return Err(vec![DeckError::new(kind, span)]);
     }
+    let mut numbering = crate::model::Numbering::after(&model);
     // Interior nodes of beams of ORDER p, after the divisions' (model/order.rs). The arcs
     // were validated card by card: this cannot fail on a parsed deck, but says so if it does.
     if let Err(e) = model.raise_orders(&mut numbering) {

@@ -56,6 +56,7 @@ impl Builder<'_> {
                 span,
             },
         );
+        self.free_dofs += fixed.iter().filter(|f| !**f).count() as u64;
     }
 
     pub(super) fn node(&mut self, card: &Card<'_>) -> R<()> {
@@ -84,7 +85,9 @@ impl Builder<'_> {
                     Span::new(id_span.start, last_span.end),
                 ));
             }
-            generation_size(id, last, Span::new(id_span.start, last_span.end))?;
+            let at = Span::new(id_span.start, last_span.end);
+            generation_size(id, last, at)?;
+            self.fits(u64::from(last - id) + 1, 0, id, last, at)?;
             let n = last - id;
             for i in 0..=n {
                 let p = if i == 0 {

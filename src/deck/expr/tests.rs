@@ -92,16 +92,21 @@ fn deep_nesting_is_a_located_error() {
         assert_eq!(e.kind, ExprErrorKind::TooDeep, "{}", &text[..20]);
         assert!(e.at > 0 && e.at < 1000, "{}", e.at);
     }
-    // At the limit it still evaluates: MAX_DEPTH - 1 parentheses (the outermost
-    // level is the expression itself).
-    let ok = format!(
-        "{}2{}",
-        "(".repeat(MAX_DEPTH - 1),
-        ")".repeat(MAX_DEPTH - 1)
-    );
-    assert_eq!(ev(&ok), Ok(2.0));
-    let ok = vec!["1"; MAX_DEPTH].join("^");
+    // At the limit it still evaluates: MAX_DEPTH parentheses, calls or signs (grammar.md:
+    // "100 levels"; the expression itself is not one), MAX_DEPTH powers; one more is an
+    // error.
+    for (open, close) in [("(", ")"), ("sqrt(", ")"), ("-", "")] {
+        let nest = |k: usize| format!("{}4{}", open.repeat(k), close.repeat(k));
+        assert!(ev(&nest(MAX_DEPTH)).is_ok(), "{open}");
+        assert_eq!(
+            ev(&nest(MAX_DEPTH + 1)).unwrap_err().kind,
+            ExprErrorKind::TooDeep
+        );
+    }
+    let ok = vec!["1"; MAX_DEPTH + 1].join("^");
     assert_eq!(ev(&ok), Ok(1.0));
+    let deep = vec!["1"; MAX_DEPTH + 2].join("^");
+    assert_eq!(ev(&deep).unwrap_err().kind, ExprErrorKind::TooDeep);
 }
 
 #[test]
