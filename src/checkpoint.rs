@@ -33,8 +33,9 @@ const MAX_BYTES: u64 = 1 << 40;
 /// Name of the checkpoint being written (renamed to [`FILE_NAME`] once whole).
 pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// Version of the file format; a checkpoint of another version is refused. (2: the
-/// integrator's state names the time integration scheme that wrote it.)
-pub const FORMAT_VERSION: u32 = 2;
+/// integrator's state names the time integration scheme that wrote it; 3: it holds the
+/// energy guard's record, and the step controller its regrowth after a landing.)
+pub const FORMAT_VERSION: u32 = 3;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 
@@ -220,6 +221,7 @@ mod tests {
                 h: 1e-3,
                 good: 0,
                 retry: None,
+                regrow: None,
             },
             integrator: integ.save_state().expect("simplicial"),
             writer: WriterState::default(),

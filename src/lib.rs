@@ -16,6 +16,7 @@ pub mod elements;
 pub mod failpoint;
 pub mod figure;
 pub mod interrupt;
+pub mod interval;
 pub mod lagrange;
 pub mod model;
 pub mod modes;

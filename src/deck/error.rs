@@ -278,19 +278,32 @@ pub enum DeckErrorKind {
         /// Why.
         reason: crate::model::SplineError,
     },
-    /// An EXPR function whose value or derivatives are not finite in the analysis's span.
+    /// An EXPR function not shown finite, with the derivatives its use needs, on the
+    /// domain of that use (interval arithmetic: `deck/build/functions.rs`).
     #[error(
-        "function {id}: `{text}` or one of its first two time derivatives is not finite at t = {t} s (checked at 1001 instants of the analysis's span [0, {end}] s)"
+        "function {id}: `{part}` in `{text}`: its {what} {} at {var} = {at} {unit} ({var} in [{}, {}] {unit} is the domain the run can reach; shown by interval arithmetic, which bounds the expression at every double of it)",
+        if *sure { "is not finite" } else { "could not be shown finite (its enclosure stays unbounded)" },
+        domain.0, domain.1
     )]
     FunctionNotFinite {
         /// The function's number.
         id: u32,
         /// The expression.
         text: String,
-        /// The first instant found.
-        t: f64,
-        /// The analysis's end time (1 for a static one).
-        end: f64,
+        /// The innermost part whose enclosure blew up.
+        part: String,
+        /// `value`, `first derivative` or `second derivative`.
+        what: String,
+        /// The variable (`t`, `the deflection`).
+        var: String,
+        /// Where, rounded to 9 digits.
+        at: f64,
+        /// The variable's unit.
+        unit: String,
+        /// Whether the `f64` evaluation itself is not finite there.
+        sure: bool,
+        /// The domain checked.
+        domain: (f64, f64),
     },
     /// An expression that does not parse.
     #[error("bad expression `{text}`: expected {expected}, found {found}")]

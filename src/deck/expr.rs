@@ -58,7 +58,7 @@ pub(crate) enum ExprErrorKind {
 /// recursive descent stays well inside a thread's stack (a few hundred bytes per level).
 pub const MAX_DEPTH: usize = 100;
 
-use crate::model::{BinOp, Expr, Func};
+use crate::model::{At, BinOp, Expr, Func};
 
 /// Whether a field's text is meant as an expression (rather than a keyword or a malformed
 /// number): it contains `$`, `(`, `)`, `*`, `/` or `^`, is `pi`, or has a `+`/`-` that is
@@ -201,7 +201,7 @@ impl Parser<'_, '_> {
             _ => None,
         };
         Ok(Node {
-            e: Expr::Bin(op, Box::new(a.e), Box::new(b.e)),
+            e: Expr::Bin(op, Box::new(a.e), Box::new(b.e), At::span(start, self.pos)),
             v,
         })
     }
@@ -255,11 +255,12 @@ impl Parser<'_, '_> {
     fn unary_inner(&mut self) -> Result<Node, ExprError> {
         match self.peek() {
             Some(b'-') => {
+                let start = self.pos;
                 self.pos += 1;
                 let x = self.unary()?;
                 Ok(Node {
                     v: x.v.map(|v| -v),
-                    e: Expr::Neg(Box::new(x.e)),
+                    e: Expr::Neg(Box::new(x.e), At::span(start, self.pos)),
                 })
             }
             Some(b'+') => {
@@ -359,7 +360,7 @@ impl Parser<'_, '_> {
                     None => None,
                 };
                 Ok(Node {
-                    e: Expr::Call(func, Box::new(x.e)),
+                    e: Expr::Call(func, Box::new(x.e), At::span(start, self.pos)),
                     v,
                 })
             }

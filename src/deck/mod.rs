@@ -112,7 +112,12 @@ pub fn strip_spans(model: &mut Model) {
     model.nodes.values_mut().for_each(|x| x.span = zero);
     model.materials.values_mut().for_each(|x| x.span = zero);
     model.sections.values_mut().for_each(|x| x.span = zero);
-    model.functions.values_mut().for_each(|x| x.span = zero);
+    for f in model.functions.values_mut() {
+        f.span = zero;
+        if let crate::model::Function::Expr(e) = &mut f.function {
+            e.field = zero;
+        }
+    }
     model.elements.values_mut().for_each(|x| x.span = zero);
     model.loads.iter_mut().for_each(|x| x.span = zero);
     model.initial.iter_mut().for_each(|x| x.span = zero);

@@ -285,6 +285,18 @@ impl Element for Spring {
 
     fn diagnose(&self, nodes: &[NodeState]) -> Option<String> {
         let d = nodes[self.nodes[1]].x - nodes[self.nodes[0]].x;
+        // A force–deflection law not finite where the run took the spring (beyond the
+        // deflections the deck showed it finite on: deck/build/functions.rs).
+        if let Some(f) = &self.curve {
+            let delta = d.norm() - self.l_ref;
+            let (v, slope) = curve_value(f, delta);
+            if !(v.is_finite() && slope.is_finite()) {
+                return Some(format!(
+                    "{} (SPRING): its force–deflection curve is not finite at the deflection {delta:.6e} m (force {v:e} N, slope {slope:e} N/m)",
+                    self.id
+                ));
+            }
+        }
         self.degenerate(&d).then(|| {
             format!(
                 "{} (SPRING): its nodes meet or pass through each other (length {:.3e} m, line of action reversed since the last step: {}): a spring's direction is undefined at zero length",

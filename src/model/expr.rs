@@ -8,6 +8,9 @@
 
 use crate::dual::Jet2;
 
+mod proof;
+pub use proof::{Blowup, IJet, Kink};
+
 /// A function the expression grammar can call.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Func {
@@ -117,7 +120,27 @@ impl BinOp {
     }
 }
 
-/// A node of an expression tree.
+/// Where a node of an expression is in the expression's text: byte offset and length
+/// (what a located error points at).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct At {
+    /// Byte offset in the text.
+    pub start: u32,
+    /// Length in bytes.
+    pub len: u32,
+}
+
+impl At {
+    /// The bytes `start..end` of the text.
+    pub fn span(start: usize, end: usize) -> Self {
+        At {
+            start: u32::try_from(start).unwrap_or(u32::MAX),
+            len: u32::try_from(end.saturating_sub(start)).unwrap_or(u32::MAX),
+        }
+    }
+}
+
+/// A node of an expression tree. The operations carry where they are in the text ([`At`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expr {
     /// A number (also `pi`).
@@ -132,11 +155,11 @@ pub enum Expr {
     /// The time `t`.
     Time,
     /// `-x`.
-    Neg(Box<Expr>),
+    Neg(Box<Expr>, At),
     /// `a op b`.
-    Bin(BinOp, Box<Expr>, Box<Expr>),
+    Bin(BinOp, Box<Expr>, Box<Expr>, At),
     /// `f(x)`.
-    Call(Func, Box<Expr>),
+    Call(Func, Box<Expr>, At),
 }
 
 impl Expr {
@@ -145,9 +168,9 @@ impl Expr {
         match self {
             Expr::Num(v) | Expr::Param { value: v, .. } => Jet2::constant(*v),
             Expr::Time => Jet2::variable(t),
-            Expr::Neg(x) => -x.jet(t),
-            Expr::Bin(op, a, b) => op.apply_jet(a.jet(t), b.jet(t)),
-            Expr::Call(f, x) => f.apply_jet(x.jet(t)),
+            Expr::Neg(x, _) => -x.jet(t),
+            Expr::Bin(op, a, b, _) => op.apply_jet(a.jet(t), b.jet(t)),
+            Expr::Call(f, x, _) => f.apply_jet(x.jet(t)),
         }
     }
 
@@ -156,8 +179,8 @@ impl Expr {
         match self {
             Expr::Num(_) | Expr::Param { .. } => false,
             Expr::Time => true,
-            Expr::Neg(x) | Expr::Call(_, x) => x.depends_on_time(),
-            Expr::Bin(_, a, b) => a.depends_on_time() || b.depends_on_time(),
+            Expr::Neg(x, _) | Expr::Call(_, x, _) => x.depends_on_time(),
+            Expr::Bin(_, a, b, _) => a.depends_on_time() || b.depends_on_time(),
         }
     }
 }
@@ -170,6 +193,8 @@ pub struct TimeExpr {
     pub text: String,
     /// Its tree.
     pub expr: Expr,
+    /// Where the field is in the deck (errors inside the expression point into it).
+    pub field: super::Span,
 }
 
 impl TimeExpr {
@@ -197,10 +222,12 @@ mod tests {
     /// a few roundings in each).
     #[test]
     fn tree_jets_match_closed_forms() {
+        let at = At::default();
         let e = Expr::Bin(
             BinOp::Mul,
-            b(Expr::Bin(BinOp::Pow, b(Expr::Time), b(Expr::Num(2.0)))),
-            b(Expr::Call(Func::Sin, b(Expr::Time))),
+            b(Expr::Bin(BinOp::Pow, b(Expr::Time), b(Expr::Num(2.0)), at)),
+            b(Expr::Call(Func::Sin, b(Expr::Time), at)),
+            at,
         );
         assert!(e.depends_on_time());
         for x in [-1.3, 0.0, 0.4, 5.0] {
@@ -215,10 +242,13 @@ mod tests {
                 assert!((a - w).abs() <= 1e-13 * (1.0 + w.abs()), "d{k} at {x}");
             }
         }
-        let k = Expr::Neg(b(Expr::Param {
-            name: "w".into(),
-            value: 4.0,
-        }));
+        let k = Expr::Neg(
+            b(Expr::Param {
+                name: "w".into(),
+                value: 4.0,
+            }),
+            at,
+        );
         assert!(!k.depends_on_time());
         assert_eq!(k.jet(3.0), Jet2::constant(-4.0));
         for f in Func::ALL {

@@ -24,7 +24,7 @@ mod summary;
 
 pub use clearance::{ClearanceData, ContactLaw};
 pub use drive::{Drive, NodeMotion};
-pub use expr::{BinOp, Expr, Func, TimeExpr};
+pub use expr::{At, BinOp, Blowup, Expr, Func, IJet, Kink, TimeExpr};
 pub use function::{CubicSpline, Function, SplineError};
 pub use ids::{ElementId, FunctionId, MaterialId, NodeId, SectionId};
 pub use mesh::{Division, MeshError, Numbering, axis_points, uniform_params};

@@ -169,6 +169,13 @@ pub struct Integrator {
     /// at its next Newton iteration ([`FailureReason::Aborted`]); the state is then left
     /// as a failed attempt leaves it. `None` = never.
     pub abort: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// The energy guard's record along the run ([`crate::solver::energy_guard`]).
+    pub balance: crate::solver::energy_guard::Balance,
+    /// The scheme's `g` of the energy guard ([`crate::solver::energy_guard::bound`]).
+    pub guard_g: f64,
+    /// The guard's measure of the accepted state, kept for the next step while nothing
+    /// changed the state: (steps, restarts, t) when it was taken.
+    pub(super) guard_cache: Option<(u64, u64, f64, crate::solver::energy_guard::Measure)>,
     /// Step size the numeric LU in `sys.matrix` was computed for (NaN = none valid): a later
     /// step of the same size starts from it (modified Newton).
     pub(super) lu_step: f64,
@@ -248,6 +255,7 @@ impl Integrator {
         let nodes: Vec<NodeState> = sys.x0.iter().map(|x| NodeState::at_rest(*x)).collect();
         let n = sys.n_eq();
         let nn = nodes.len();
+        let esdirk_scheme = esdirk::tableau_of(&scheme).is_some();
         let esdirk = esdirk::tableau_of(&scheme)
             .filter(|_| dynamic)
             .map(|tab| Box::new(esdirk::Stages::sized(&sys, tab)));
@@ -286,6 +294,14 @@ impl Integrator {
             redundancy: Default::default(),
             notices: Vec::new(),
             started: false,
+            balance: Default::default(),
+            // The stage schemes have no acceleration history: g = 0 (energy_guard::bound).
+            guard_g: if esdirk_scheme {
+                0.0
+            } else {
+                crate::solver::energy_guard::bound::run_bound(&AlphaParams::of(&scheme))
+            },
+            guard_cache: None,
             sys,
         }
     }

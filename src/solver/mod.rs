@@ -59,9 +59,9 @@ pub enum FailureReason {
     /// Newton converged but an element refused the step as too long (e.g. an impact
     /// resolved by too few steps): retry with this step, s.
     StepRefused(f64),
-    /// Newton converged to a state holding far more energy than the step's start state
-    /// and work can pay for ([`energy_guard`]): a spurious root, refused like a divergence.
-    /// (Boxed: `Failure` travels in `Result`s.)
+    /// The step, or the run of steps it ends, created more energy than no work paid for and
+    /// than the scheme's error allows ([`energy_guard`]): a spurious root, or a burst;
+    /// refused like a divergence. (Boxed: `Failure` travels in `Result`s.)
     EnergyJump(Box<energy_guard::EnergyJump>),
     /// An element refused a step already at the run's smallest step (`MINSTEP`): its
     /// event (e.g. an impact) would be resolved by fewer steps than it needs, and
@@ -145,8 +145,8 @@ impl std::fmt::Display for Failure {
                 element.0, self.step
             ),
             FailureReason::EnergyJump(j) => format!(
-                "the step created {:.3e} J of energy that no work paid for (energy in play {:.3e} J before the step, {:.3e} J after, work of the step {:.3e} J): a spurious solution, refused",
-                j.created, j.before, j.after, j.work
+                "the integration created {:.3e} J of energy that no work paid for since t = {:.6e} s ({:.3e} J in this step; energy in play {:.3e} J before the step, {:.3e} J after, work of the step {:.3e} J), more than the scheme's error allows ({:.3e} J: docs/stability.md, \"The energy guard's bound\"); steps down to the smallest allowed did not avoid it",
+                j.created, j.since, j.by_step, j.before, j.after, j.work, j.bound
             ),
         };
         if self.load_steps {
@@ -225,6 +225,9 @@ pub struct LoopState {
     pub good: u32,
     /// The step an element asked for, tried once before `h`.
     pub retry: Option<f64>,
+    /// After a step shorter than half the nominal one (an event's landing), the longest
+    /// next step: steps grow back by doubling, not at once ([`regrowth`]).
+    pub regrow: Option<f64>,
 }
 
 /// How a run ended before its end time without failing.
@@ -330,6 +333,54 @@ pub fn ladder_step(h: f64, proposal: f64, h0: f64) -> f64 {
     }
 }
 
+/// The distance from `t` to the next instant `k h₀` of a fixed-step run's grid (one closer
+/// than 1e-3 h₀ counts as reached: t is a sum of steps, on the grid within round-off).
+pub(crate) fn grid_distance(t: f64, h0: f64) -> f64 {
+    let k = (t / h0).round();
+    let next = if (t - k * h0).abs() <= 1e-6 * h0 {
+        (k + 1.0) * h0
+    } else {
+        (t / h0).ceil() * h0
+    };
+    let d = next - t;
+    if d < 1e-3 * h0 { d + h0 } else { d }
+}
+
+/// The step from `t` toward the grid `k h₀` of a fixed-step run, given the step `h` the
+/// controller would take: the distance `d` to the next grid instant split into `n` equal
+/// steps no longer than `h`. A step is then never shorter than half the one tried unless
+/// `d` itself is (an event landed the run just before a grid instant, which the histories'
+/// sampling needs), and steps of a cut size keep fitting the grid (halving them halves
+/// `d/n`).
+///
+/// Why not the longest steps and then what is left: that remainder, a sliver (3.5e-7 s
+/// after steps of 1.25e-5–5e-5 s on the seed's scene, and again every 1e-4 s as the cut
+/// steps never divided the grid), gives the α schemes' acceleration history the unresolved
+/// modes' true accelerations, which the next, 36–140 times longer steps turn into energy:
+/// 66 J created in 2 ms at t = 23.18 s of `decks/pendulum.dat` run to 30 s (issue 35,
+/// `docs/stability.md`).
+/// A step not limited by anything but the controller (`free`) may be up to 1e-3 longer
+/// than `h` to land on the grid, as a breakpoint that close counts as reached: after a
+/// landing 1e-9 s before a grid instant the next one is 1.00001 h away, one step, not two.
+pub fn grid_step(t: f64, h: f64, h0: f64, free: bool) -> f64 {
+    let d = grid_distance(t, h0);
+    let slack = if free { 1e-3 } else { 1e-9 };
+    // n steps of d/n ≤ h (1 + slack).
+    let n = (d / h - slack).ceil().max(1.0);
+    d / n
+}
+
+/// The longest step after an accepted step `taken` of an α scheme whose nominal step is
+/// `h`: `2 taken` while that is below `h`, else no limit. Why: a step much shorter than
+/// the ones around it (a contact's landing at MINSTEP) resolves the mesh's unresolved
+/// modes and gives the acceleration history their true accelerations; a next step
+/// hundreds of times longer turns them into energy (11 J per step, 40 J in 0.7 ms at
+/// t = 28.518 s of the seed's scene run to 30 s: issue 35, `docs/stability.md`). Doubling
+/// keeps every step-size change within the factor 2 of the controller's own halving.
+pub fn regrowth(taken: f64, h: f64) -> Option<f64> {
+    (2.0 * taken < h * (1.0 - 1e-9)).then_some(2.0 * taken)
+}
+
 /// Runs the model's analysis, reporting every accepted state to `obs`.
 pub fn run(model: &Model, obs: &mut dyn Observer) -> Result<RunReport, RunError> {
     let mut integ = prepare(model)?;
@@ -362,7 +413,51 @@ pub fn run_from(
 
 #[cfg(test)]
 mod tests {
-    use super::ladder_step;
+    use super::{grid_step, ladder_step};
+
+    /// Steps back to the grid: never shorter than half the step tried (when the grid
+    /// instant is at least that far), never longer, and they land on the grid; a step of
+    /// the grid's size stays on it. The seed's sliver: from t = 23.1840 s with steps of
+    /// 4.983e-5 s, three steps of 3.33e-5 s, not two and 3.5e-7 s.
+    #[test]
+    fn grid_steps_land_without_slivers() {
+        let h0 = 1e-4;
+        for (t0, h) in [
+            (0.0, 1e-4),
+            (23.18390035, 9.965e-5),
+            (0.5 * h0 + 3.7e-7, 1e-4),
+            (7.0 * h0 - 3.0e-5, 1e-4),
+            (7.0 * h0 - 3.0e-5, 2.491e-5),
+            (12.0 * h0 + 9.8e-8, 1.246e-5),
+            (23.184, 4.983e-5),
+            (3.0 * h0 + 0.3 * h0, 0.25 * h0),
+        ] {
+            let mut t = t0;
+            let mut landed = false;
+            for _ in 0..200 {
+                let s = grid_step(t, h, h0, false);
+                let d = super::grid_distance(t, h0);
+                assert!(
+                    s <= h * (1.0 + 1e-9) && s >= (0.5 * h).min(d) * (1.0 - 1e-9),
+                    "t = {t:e}, h = {h:e}: step {s:e}"
+                );
+                t += s;
+                if ((t / h0).round() * h0 - t).abs() <= 1e-6 * h0 {
+                    landed = true;
+                    break;
+                }
+            }
+            assert!(landed, "t0 = {t0:e}, h = {h:e} never reached the grid");
+        }
+        // On the grid with the grid's step: exactly h0.
+        assert!((grid_step(5.0 * h0, h0, h0, true) / h0 - 1.0).abs() < 1e-12);
+        // 1e-9 s short of a grid instant: one step of 1.00001 h0 when the step is free.
+        let t = 5.0 * h0 - 1e-9;
+        assert!((grid_step(t, h0, h0, true) - (h0 + 1e-9)).abs() < 1e-15);
+        assert!((grid_step(t, h0, h0, false) - 0.5 * (h0 + 1e-9)).abs() < 1e-15);
+        let s = grid_step(23.184, 4.983e-5, h0, true);
+        assert!((s - h0 / 3.0).abs() < 1e-12, "{s:e}");
+    }
 
     /// Whether `h` is a rung `h0 2^(k/4)` (to round-off).
     fn is_rung(h: f64, h0: f64) -> bool {

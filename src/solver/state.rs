@@ -106,6 +106,8 @@ pub struct IntegratorState {
     rhs: Vec<f64>,
     lu: LuState,
     elements: Vec<ElementState>,
+    /// The energy guard's record along the run ([`crate::solver::energy_guard::Balance`]).
+    balance: crate::solver::energy_guard::Balance,
 }
 
 /// Why a saved state cannot be restored into an integrator.
@@ -180,6 +182,7 @@ impl Integrator {
             rhs: self.sys.rhs.clone(),
             lu: self.sys.matrix.save_state(),
             elements: self.sys.elements.iter().map(|e| e.save_state()).collect(),
+            balance: self.balance,
         })
     }
 
@@ -251,6 +254,8 @@ impl Integrator {
         self.error_next = s.error_next;
         self.event_floor = s.event_floor;
         self.lu_step = s.lu_step;
+        self.balance = s.balance;
+        self.guard_cache = None;
         Ok(())
     }
 }

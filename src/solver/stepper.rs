@@ -17,7 +17,7 @@ use super::{
     Failure, FailureReason, Integrator, Interruption, LoopState, Observer, Pause, RunError,
     RunReport, Snapshot, ladder_step,
 };
-use crate::model::{Analysis, Model};
+use crate::model::{Analysis, Model, Scheme};
 use std::time::Instant;
 
 /// What one call of [`Stepper::step`] did.
@@ -51,6 +51,10 @@ pub struct Stepper {
     h: f64,
     good: u32,
     retry: Option<f64>,
+    /// The α schemes' steps grow back by doubling after an event's landing
+    /// ([`super::regrowth`]): whether they do, and the longest next step.
+    regrows: bool,
+    regrow: Option<f64>,
     /// Consecutive refused attempts (reset at each accepted step), bounded by
     /// [`super::MAX_REFUSALS`].
     refusals: u32,
@@ -133,7 +137,16 @@ impl Stepper {
             h: h0,
             good: 0,
             retry: None,
+            regrow: None,
         });
+        let regrows = !adaptive
+            && matches!(
+                model.analysis,
+                Analysis::Dynamic {
+                    scheme: Scheme::Hht { .. } | Scheme::GeneralizedAlpha { .. },
+                    ..
+                }
+            );
         Ok(Stepper {
             end,
             h0,
@@ -149,6 +162,8 @@ impl Stepper {
             retry: ctl.retry,
             // Pauses come after the initial state and after each accepted step (not after a
             // refused attempt, nor at once after a restart: that state was the last pause's).
+            regrows,
+            regrow: ctl.regrow,
             refusals: 0,
             pause_due: resume.is_none(),
             cpu0,
@@ -164,6 +179,7 @@ impl Stepper {
             h: self.h,
             good: self.good,
             retry: self.retry,
+            regrow: self.regrow,
         }
     }
 
@@ -282,27 +298,23 @@ impl Stepper {
     ) -> Result<bool, RunError> {
         let (h0, hmin, hmax) = (self.h0, self.hmin, self.hmax);
         let t = integ.t;
-        let mut h_try = self
-            .retry
-            .take()
+        let asked = self.retry.take();
+        let mut h_try = asked
             .unwrap_or(self.h)
             .min(end - t)
             .min(integ.step_cap.max(hmin));
+        if let Some(r) = self.regrow.filter(|_| asked.is_none()) {
+            h_try = h_try.min(r);
+        }
         if !self.adaptive {
             // Fixed steps come back to the grid t = k h₀ after an event moved them off it,
-            // so that histories keep their sampling times.
-            // (t is a sum of steps: "on the grid" within round-off, and never a sliver.)
-            let k = (t / h0).round();
-            let next_grid = if (t - k * h0).abs() <= 1e-6 * h0 {
-                (k + 1.0) * h0
-            } else {
-                (t / h0).ceil() * h0
+            // so that histories keep their sampling times: in equal steps
+            // ([`super::grid_step`]); a step an element asked for (an event's time) is
+            // taken as asked, or to the grid instant before it.
+            h_try = match asked {
+                Some(_) => h_try.min(super::grid_distance(t, h0)),
+                None => super::grid_step(t, h_try, h0, h_try >= self.h),
             };
-            let mut to_grid = next_grid - t;
-            if to_grid < 1e-3 * h0 {
-                to_grid += h0;
-            }
-            h_try = h_try.min(to_grid);
         }
         // A breakpoint closer than 1e-3 h_try ahead counts as reached (round-off: t, a sum
         // of steps, is 2.4e-15 s short of 0.02 s after 10,240 steps of 1.953125e-6 s), and
@@ -351,6 +363,9 @@ impl Stepper {
                     integ.stats.restarts += 1;
                 }
                 self.good += 1;
+                if self.regrows {
+                    self.regrow = super::regrowth(h_try, self.h);
+                }
                 if self.adaptive {
                     // The local error estimate proposes the next step; it is taken from
                     // a ladder h₀·2^(k/4), and grows only by two rungs or more, so that

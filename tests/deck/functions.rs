@@ -201,8 +201,25 @@ fn bad_functions_are_located_errors() {
         (f(" 1 EXPR (2*t"), 4, 13, "`)`"),
         (f(" 1 EXPR"), 4, 8, "an expression of t"),
         (f(" 1 EXPR t+1/0"), 4, 11, "not a finite number"),
-        (f(" 1 EXPR sqrt(t)"), 4, 2, "not finite at t = 0 s"),
-        (f(" 1 EXPR log(1.5-t)"), 4, 2, "not finite at t = 1.5 s"),
+        (
+            f(" 1 EXPR sqrt(t)"),
+            4,
+            9,
+            "first derivative is not finite at t = 0 s",
+        ),
+        (
+            f(" 1 EXPR log(1.5-t)"),
+            4,
+            9,
+            "value is not finite at t = 1.5 s",
+        ),
+        // A pole between the 1001 instants the old sampling checked (issue 35).
+        (
+            f(" 1 EXPR 1+1/(t-0.0123457)"),
+            4,
+            11,
+            "value could not be shown finite (its enclosure stays unbounded) at t = 0.0123457 s",
+        ),
         (f(" 1 TABLE 0 0 1 sin(t)"), 4, 20, "unknown function `t`"),
         (f(" 1 WAVE 1"), 4, 4, "expected one of TABLE, CONSTANT"),
     ];
@@ -232,4 +249,106 @@ fn constant_expressions_and_static_spans() {
     .unwrap();
     assert_eq!(function(&m, 1).derivatives(7.0), Some([6.0, 0.0, 0.0]));
     assert!(function(&m, 2).derivatives(1.0).unwrap()[0].abs() < 1e-16);
+}
+
+/// The deck `name` with `from` replaced by `to` (one occurrence, which must exist).
+fn edited(name: &str, from: &str, to: &str) -> String {
+    let text =
+        std::fs::read_to_string(format!("{}/decks/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    assert!(text.contains(from), "{name} has no `{from}`");
+    text.replacen(from, to, 1)
+}
+
+/// The first error of a deck (a refused element also leaves its references undefined):
+/// its text and (line, column).
+fn one_error(deck: &str) -> (String, Option<(usize, usize)>) {
+    let e = errors_of(deck);
+    (e.errors()[0].to_string(), e.line_col(0))
+}
+
+/// Issue 35, "functions proven finite": an EXPR used as a SPRING's force–deflection law is
+/// shown finite on the deflections the spring can reach ([−L_ref, D], here [−1, 1] m for
+/// the 1 m spring of `spring_mass.dat`, whose nodes span 1 m): a pole at δ = 0.3 m, which
+/// the run crosses only if stretched that far, is refused and located at the quotient,
+/// naming the deflection; a law finite there (a cubic) is accepted. The old check read
+/// such a curve over [0, END] as if it were a time function.
+#[test]
+fn a_spring_law_is_proven_finite_on_its_deflections() {
+    let with = |law: &str| {
+        edited(
+            "spring_mass.dat",
+            "ELEMENTS\n  1  SPRING 1 2  K $k  C $c",
+            &format!("FUNCTIONS\n  7 EXPR {law}\nELEMENTS\n  1  SPRING 1 2  K $k  C $c  CURVE 7"),
+        )
+    };
+    let (msg, at) = one_error(&with("5/(t-0.3)"));
+    assert!(
+        msg.contains("`5/(t-0.3)`") && msg.contains("deflection = 0.3 m"),
+        "{msg}"
+    );
+    assert_eq!(at, Some((17, 10)), "{msg}");
+    parse_deck(&with("1e3*t^3"), "s.dat").expect("a cubic law is finite on [-1, 1] m");
+}
+
+/// A driver's law whose velocity jumps is refused, located at the `abs` whose kink it is
+/// (`0.3 (|t − 0.5| − 0.5)`: ḟ jumps from −0.3 to 0.3 at 0.5 s, by 0.6, measured by interval arithmetic on
+/// both sides), and so is a SINE started inside the run (its velocity jumps by A ω); kinks
+/// that cancel (the spin-up law of `decks/benchmarks/spinup.dat`, `min(t, T)` written with
+/// `abs`) are not, nor is a HAVERSINE.
+#[test]
+fn a_driver_whose_velocity_jumps_is_refused() {
+    let kinked = edited(
+        "driven_arm.dat",
+        "  1 HAVERSINE 0 $T",
+        "  1 EXPR 0.3*(abs(t-0.5)-0.5)",
+    );
+    let (msg, at) = one_error(&kinked);
+    assert!(
+        msg.contains("velocity jumps by 6.000000e-1") && msg.contains("t = 0.5 s"),
+        "{msg}"
+    );
+    assert!(msg.contains("abs(t-0.5)"), "{msg}");
+    assert_eq!(at, Some((19, 15)), "{msg}");
+    let started = edited(
+        "driven_arm.dat",
+        "  1 HAVERSINE 0 $T",
+        "  1 SINE 0.5 FREQ 1 START 0.2",
+    );
+    let (msg, _) = one_error(&started);
+    assert!(msg.contains("START 0.2"), "{msg}");
+    parse_deck(
+        &std::fs::read_to_string(format!(
+            "{}/decks/benchmarks/spinup.dat",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+        "spinup.dat",
+    )
+    .expect("kinks that cancel are no jump");
+}
+
+/// `CLEARANCE … LAW LN K e EXPONENT n`: an exponent outside the derived range (where
+/// `K δⁿ` underflows to no force over the penetrations that matter: the issue's 1e308 let
+/// the journal 0.7 mm through its 0.5 mm clearance with no force) is refused, located,
+/// with the range; 1.5 and 10 are accepted.
+#[test]
+fn a_clearance_exponent_beyond_its_derived_range_is_refused() {
+    let law = "LAW LN 1e10 0.8";
+    let (msg, at) = one_error(&edited(
+        "clearance_impact.dat",
+        law,
+        "LAW LN 1e10 0.8 EXPONENT 1e308",
+    ));
+    assert!(
+        msg.contains("EXPONENT") && msg.contains("in [0.000, 16.759]"),
+        "{msg}"
+    );
+    assert!(at.is_some_and(|(l, _)| l == 15), "{at:?}");
+    for ok in ["1.5", "10"] {
+        parse_deck(
+            &edited("clearance_impact.dat", law, &format!("{law} EXPONENT {ok}")),
+            "c.dat",
+        )
+        .unwrap_or_else(|e| panic!("EXPONENT {ok}: {e}"));
+    }
 }

@@ -58,7 +58,7 @@ impl Builder<'_> {
                     if v <= 0.0 {
                         return Err(out_of_range("EXPONENT (Hertz exponent n)", t, "> 0", s));
                     }
-                    exponent = Some((v, ks));
+                    exponent = Some((v, s, t.to_string(), ks));
                 }
                 "MU" => mu = c.number_in("MU (friction coefficient)", ">= 0", |v| v >= 0.0)?,
                 "VREG" => vreg = c.number_in("VREG (friction speed)", "> 0 m/s", |v| v > 0.0)?,
@@ -91,9 +91,18 @@ impl Builder<'_> {
             return Err(out_of_range("CLEARANCE (radial clearance)", ct, &range, cs));
         }
         let mut law = law.ok_or_else(|| miss("LAW KV <k> <c> or LAW LN <K> <e>"))?;
-        if let Some((n, ns)) = exponent {
+        if let Some((n, ns, nt, kws)) = exponent {
             match &mut law {
-                ContactLaw::LankaraniNikravesh { exponent, .. } => *exponent = n,
+                ContactLaw::LankaraniNikravesh { k, exponent, .. } => {
+                    let (lo, hi) = exponent_range(*k, clr);
+                    if !(n >= lo && n <= hi) {
+                        let range = format!(
+                            "in [{lo:.3}, {hi:.3}]: the range where K δⁿ and its slope n K δⁿ⁻¹ are normal doubles for every penetration δ from the gap's round-off ε·c to the clearance c (K = {k:e} N/mⁿ, c = {clr:e} m; beyond it the law underflows to no force or overflows)"
+                        );
+                        return Err(out_of_range("EXPONENT (Hertz exponent n)", &nt, &range, ns));
+                    }
+                    *exponent = n
+                }
                 ContactLaw::KelvinVoigt { .. } => {
                     return Err(DeckError::new(
                         K::UnknownKeyword {
@@ -101,7 +110,7 @@ impl Builder<'_> {
                             context: c.ctx.clone(),
                             expected: "EXPONENT only with LAW LN (the KV law is linear)".into(),
                         },
-                        ns,
+                        kws,
                     ));
                 }
             }
@@ -117,4 +126,29 @@ impl Builder<'_> {
             impact_steps: steps,
         })
     }
+}
+
+/// The Hertz exponents `n` for which the law `K δⁿ` of a clearance `c` is a usable double:
+/// over the penetrations `δ ∈ [δ₀, c]`, `δ₀ = ε c` (the round-off of the gap, a difference
+/// of lengths of size `c`: a smaller penetration is noise), the force and its slope must be
+/// normal (`≥ f64::MIN_POSITIVE`) and finite (`≤ f64::MAX`). With `δ < 1` (a clearance
+/// below a metre) `K δⁿ` falls with `n` and is smallest at `δ₀`:
+/// `n ≤ ln(K/MIN_POSITIVE)/ln(1/δ₀)`; its slope `n K δⁿ⁻¹` is largest at `δ₀` when `n < 1`:
+/// `n ≥ 1 − ln(MAX/K)/ln(1/δ₀)`; with `c ≥ 1` the force at `c` must not overflow,
+/// `n ≤ ln(MAX/K)/ln c`. (K = 6.6e10 N/m^1.5, c = 0.5 mm: n in [0, 16.8]; the issue's
+/// `EXPONENT 1e308` let the journal 0.7 mm past its clearance with a force of 0.)
+pub(super) fn exponent_range(k: f64, c: f64) -> (f64, f64) {
+    let d0 = f64::EPSILON * c;
+    let (ln_min, ln_max) = (f64::MIN_POSITIVE.ln(), f64::MAX.ln());
+    let mut hi = f64::INFINITY;
+    let mut lo = 0.0f64;
+    if d0 < 1.0 {
+        let l = -d0.ln();
+        hi = hi.min((k.ln() - ln_min) / l);
+        lo = lo.max(1.0 - (ln_max - k.ln()) / l);
+    }
+    if c > 1.0 {
+        hi = hi.min((ln_max - k.ln()) / c.ln());
+    }
+    (lo, hi)
 }

@@ -44,9 +44,11 @@ impl DeckErrorKind {
                 cut(found);
                 cut(previous);
             }
-            K::BadExpression { text, .. }
-            | K::ExpressionTooDeep { text, .. }
-            | K::FunctionNotFinite { text, .. } => cut(text),
+            K::BadExpression { text, .. } | K::ExpressionTooDeep { text, .. } => cut(text),
+            K::FunctionNotFinite { text, part, .. } => {
+                cut(text);
+                cut(part);
+            }
             K::ExpressionNotFinite { text, what } => {
                 cut(text);
                 cut(what);

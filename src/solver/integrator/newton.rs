@@ -2,6 +2,7 @@
 //! tests) and the diagnosis of a failed step.
 
 use super::*;
+use crate::solver::energy_guard;
 
 impl Integrator {
     /// What the elements have to say about the last trial state (or, if an element is
@@ -14,10 +15,11 @@ impl Integrator {
             .collect()
     }
 
-    /// The drivers' work over a trial step of size `h` (trapezoidal, as the loads'), J.
-    fn driver_work(&self, h: f64, ctx: &EvalContext) -> f64 {
+    /// The drivers' and controlled inputs' powers at the start and at the end of a trial step (W: the energy
+    /// guard integrates them as the loads', trapezoidally).
+    fn driver_powers(&self, ctx: &EvalContext) -> (f64, f64) {
         if !self.sys.elements.iter().any(|e| e.does_work()) {
-            return 0.0;
+            return (0.0, 0.0);
         }
         let ctx_old = EvalContext {
             t: self.t,
@@ -26,7 +28,52 @@ impl Integrator {
         };
         let p_old = self.sys.input_power(&ctx_old, &self.nodes, &self.lambda);
         let p_new = self.sys.input_power(ctx, &self.trial, &self.trial_lambda);
-        0.5 * (p_old + p_new) * h
+        (p_old, p_new)
+    }
+
+    /// The energy guard on the trial step of size `h` (`energy_guard`): the record to keep
+    /// once the step is accepted, or the refused jump.
+    fn guard(
+        &mut self,
+        h: f64,
+        ctx: &EvalContext,
+        fref: f64,
+    ) -> Result<energy_guard::Passed, energy_guard::EnergyJump> {
+        let key = (self.stats.steps, self.stats.restarts, self.t);
+        let old = match self.guard_cache {
+            Some((s, r, t, m)) if (s, r, t) == key => m,
+            _ => energy_guard::measure(&self.sys, &self.nodes, self.t),
+        };
+        let new = energy_guard::measure(&self.sys, &self.trial, self.t + h);
+        // The round-off of the equilibrium, and what Newton leaves: positions within the
+        // increment tolerance τ of the discrete solution (τ L_ref, τ rad), velocities within
+        // c_v = ∂v/∂u times that; the energies of such a state are uncertain by
+        // Σ|p·δv| + Σ|f·δx| ≤ c_v τ (L_ref √(2T M) + √(2T J)) + τ L_ref n f_ref
+        // (M, J the model's translational and rotational masses: Cauchy–Schwarz).
+        let n = self.nodes.len() as f64;
+        let tau = self.newton.tol_increment;
+        let two_t = 2.0 * old.kinetic.max(new.kinetic).max(0.0);
+        let newton = ctx.c_v
+            * tau
+            * (self.sys.ref_length * (two_t * self.mass_ref * n).sqrt()
+                + (two_t * self.rot_mass_ref * n).sqrt())
+            + tau * self.sys.ref_length * n * fref;
+        let floor = self.residual_floor * self.sys.ref_length + newton;
+        let passed = energy_guard::check(
+            &self.balance,
+            &old,
+            &new,
+            self.driver_powers(ctx),
+            h,
+            self.t + h,
+            self.guard_g,
+            floor,
+            self.sys.elements.len(),
+        )?;
+        // Kept for the next step if the accepted state is not changed (a restart of the
+        // accelerations counts a restart and changes the key).
+        self.guard_cache = Some((self.stats.steps + 1, self.stats.restarts, self.t + h, new));
+        Ok(passed)
     }
 
     pub(super) fn failure(
@@ -356,20 +403,24 @@ impl Integrator {
         fref: f64,
     ) -> Result<StepInfo, Failure> {
         let ctx = *ctx;
-        // A converged state must not hold energy the step cannot pay for.
-        if self.dynamic
-            && let Some(j) = crate::solver::energy_guard::check_driven(
-                &self.sys,
-                &self.nodes,
-                &self.trial,
-                self.t,
-                h,
-                self.residual_floor * self.sys.ref_length,
-                self.driver_work(h, &ctx),
-            )
-        {
-            return Err(self.failure(h, FailureReason::EnergyJump(Box::new(j)), history, fref));
-        }
+        // A converged state must not hold energy the step (or the run of steps it ends)
+        // cannot pay for.
+        let passed = if self.dynamic {
+            match self.guard(h, &ctx, fref) {
+                Ok(p) => Some(p),
+                Err(j) => {
+                    self.guard_cache = None;
+                    return Err(self.failure(
+                        h,
+                        FailureReason::EnergyJump(Box::new(j)),
+                        history,
+                        fref,
+                    ));
+                }
+            }
+        } else {
+            None
+        };
         if self.dynamic
             && let Some(a) = self.adaptive.clone()
         {
@@ -389,6 +440,9 @@ impl Integrator {
             self.step_cap = next;
         }
         self.accept(h, &ctx);
+        if let Some(p) = passed {
+            self.balance = p.record();
+        }
         self.history = history;
         self.stats.newton_iterations += iter as u64;
         Ok(StepInfo {
