@@ -30,8 +30,9 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 /// Name of the checkpoint being written (renamed to [`FILE_NAME`] once whole).
 pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// Version of the file format; a checkpoint of another version is refused. (2: the
-/// integrator's state names the time integration scheme that wrote it.)
-pub const FORMAT_VERSION: u32 = 2;
+/// integrator's state names the time integration scheme that wrote it; 3: it holds the
+/// stage schemes' index-1 reaction solve's factors.)
+pub const FORMAT_VERSION: u32 = 3;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 
