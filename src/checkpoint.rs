@@ -34,7 +34,8 @@ const MAX_BYTES: u64 = 1 << 40;
 pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// Version of the file format; a checkpoint of another version is refused. (2: the
 /// integrator's state names the time integration scheme that wrote it; 3: it holds the
-/// energy guard's record, and the step controller its regrowth after a landing.)
+/// energy guard's record, and the step controller its regrowth after a landing, and the
+/// stage schemes' index-1 reaction solve's factors.)
 pub const FORMAT_VERSION: u32 = 3;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;

@@ -120,6 +120,11 @@ impl Observer for Controlled<'_> {
         self.writer.progress(t, end, stats);
     }
 
+    /// The writer's rows (the VTK series reads positions and rotations only).
+    fn reads_reactions(&self, snap: &Snapshot) -> bool {
+        self.writer.reads_reactions(snap)
+    }
+
     fn pause(&mut self, integ: &Integrator, ctl: &LoopState) -> io::Result<Pause> {
         if let Some((sig, step)) = self.failpoint
             && integ.stats.steps == step
@@ -214,7 +219,7 @@ impl Session<'_> {
         if let Some(pb) = bar {
             pb.finish_and_clear();
         }
-        let integ = &self.integ;
+        let integ = &mut self.integ;
         // Whether the state could still go on: an interruption, or a disk that failed
         // the writers (once space is freed, a restart from the last checkpoint works).
         let mut resumable = false;
@@ -233,6 +238,10 @@ impl Session<'_> {
             }
             Err(e) => return Err((EXIT_BAD_INPUT, e.to_string())),
         };
+        // The final state, written by `finish` when `EVERY` skipped it, with the reactions a
+        // written row has (an ESDIRK's from the index-1 equations, `Observer::reads_reactions`);
+        // an interrupted run writes no row there.
+        let exact = report.interrupted.is_none() && integ.exact_reactions();
         report.stats = integ.stats;
         notices_into(&mut self.writer, integ);
         if report.interrupted.is_some() {
@@ -241,9 +250,11 @@ impl Session<'_> {
                 .notes
                 .insert("signal".into(), serde_json::json!(signal));
         }
-        self.writer
-            .finish(integ, &report)
-            .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
+        let finished = self.writer.finish(integ, &report);
+        if exact {
+            integ.restore_stage_values();
+        }
+        finished.map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;
         if let Some(v) = self.vtk.as_mut() {
             v.finish(integ, report.interrupted.is_some())
                 .map_err(|e| (EXIT_FAILED, format!("{}: {e}", dir.display())))?;

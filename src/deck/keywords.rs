@@ -573,6 +573,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "write a row every n steps (>= 1, default 1)",
     ),
     kw(
+        "SUBSTEPS",
+        "OUTPUT",
+        "also write the states of the steps shorter than STEP (an impact's sub-steps)",
+    ),
+    kw(
         "DIR",
         "OUTPUT",
         "output directory (the command line's -o wins)",

@@ -475,6 +475,9 @@ pub fn write_deck(model: &Model) -> String {
         let _ = write!(s, " ELEMENTS {}", selection(&o.elements, |e| e.0));
     }
     let _ = write!(s, " EVERY {}", o.every);
+    if o.substeps {
+        s.push_str(" SUBSTEPS");
+    }
     if let Some(d) = &o.dir {
         let _ = write!(s, " DIR {d}");
     }

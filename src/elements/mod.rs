@@ -441,6 +441,16 @@ pub trait Element: Send + Sync {
         [0.0; 2]
     }
 
+    /// `B(q) v` of each of the element's multiplier rows, unscaled (`∂Φ_k/∂t` left out),
+    /// into `out` (`multipliers()` long): the derivative of `Φ` along the nodes' velocities,
+    /// `x + εv`, `R exp(εΩ̃)` (material `Ω`). `false` when the element does not give it
+    /// (the default): the solver then takes `s B` from the constraint rows of its tangent,
+    /// exact too but a whole tangent's cost. The ESDIRK stages' velocity-level rows and the
+    /// index-1 reactions' `Ḃv` use it (`solver/integrator/multipliers.rs`).
+    fn constraint_rates(&self, _nodes: &[NodeState], _out: &mut [f64]) -> bool {
+        false
+    }
+
     /// Whether a constraint of the element depends on time (a driver). Default: no.
     fn rheonomic(&self) -> bool {
         false

@@ -207,6 +207,26 @@ impl Element for Prescribed {
         true
     }
 
+    /// `B v`: the velocity's component for a displacement; for a rotation, `Φ` at
+    /// `R(I + εΩ̃)` by one dual direction.
+    fn constraint_rates(&self, nodes: &[NodeState], out: &mut [f64]) -> bool {
+        let st = &nodes[self.nodes[0]];
+        match self.motion {
+            NodeMotion::Displacement(i) => out[0] = st.v[i],
+            NodeMotion::Rotation(n) => {
+                let rw = st.r * skew(&st.w);
+                let r = Matrix3::from_fn(|i, j| Dual::<1> {
+                    re: st.r[(i, j)],
+                    eps: [rw[(i, j)]],
+                });
+                for (o, p) in out.iter_mut().zip(&self.phi_rot(&n, &r, 0.0)) {
+                    *o = p.eps[0];
+                }
+            }
+        }
+        true
+    }
+
     fn constraint_time_derivatives(&self, t: f64, k: usize) -> [f64; 2] {
         if k == self.driven_row() {
             let [_, fd, fdd] = self.law.at(t);
@@ -302,6 +322,40 @@ mod tests {
                 let lam: Vec<f64> = (0..e.multipliers()).map(|_| g.next() * 5.0).collect();
                 check_tangent(&e, &ctx(), &st, &lam, 1e-7);
                 check_tangent(&e, &static_ctx(), &st, &lam, 1e-7);
+            }
+        }
+    }
+
+    /// `B v` of [`Element::constraint_rates`] is the tangent's constraint rows applied to
+    /// `(v, Ω)`, over the scale, for every motion (to round-off).
+    #[test]
+    fn constraint_rates_are_the_tangents_constraint_rows_times_the_velocities() {
+        let x0 = [Vector3::new(0.1, 0.2, -0.1)];
+        for m in [
+            NodeMotion::Displacement(1),
+            NodeMotion::Rotation(Vector3::new(0.3, -0.5, 0.8)),
+        ] {
+            let e = Prescribed::new(ElementId(3), 0, x0[0], m, law());
+            let k = e.multipliers();
+            for seed in 1..4 {
+                let st = random_states(&x0, 0.3, 1.5, seed);
+                let mut local = Local::new(6 + k);
+                e.evaluate(&ctx(), &st, &vec![0.0; k], true, &mut local);
+                let mut rates = vec![0.0; k];
+                assert!(e.constraint_rates(&st, &mut rates));
+                for (row, r) in rates.iter().enumerate() {
+                    let bv: f64 = (0..3)
+                        .map(|d| {
+                            local.tan_at(6 + row, d) * st[0].v[d]
+                                + local.tan_at(6 + row, 3 + d) * st[0].w[d]
+                        })
+                        .sum::<f64>()
+                        / ctx().constraint_scale;
+                    assert!(
+                        (r - bv).abs() <= 1e-12 * bv.abs().max(1.0),
+                        "{m:?} {row}: {r} vs {bv}"
+                    );
+                }
             }
         }
     }

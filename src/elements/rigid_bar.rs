@@ -102,6 +102,10 @@ impl Element for RigidBar {
         self.joint.constraint_violation(nodes)
     }
 
+    fn constraint_rates(&self, nodes: &[NodeState], out: &mut [f64]) -> bool {
+        self.joint.constraint_rates(nodes, out)
+    }
+
     fn force_scale(&self, nodes: &[NodeState], gravity: &Vector3<f64>) -> f64 {
         self.inertia
             .force_scale(nodes, gravity)

@@ -32,6 +32,10 @@ pub struct OutputRequest {
     pub elements: Selection<ElementId>,
     /// Write a row every this many steps (≥ 1).
     pub every: u32,
+    /// Also write the states of the steps shorter than the deck's STEP between the instants
+    /// `k·every·STEP` (an impact's or an event's sub-steps; deck: `SUBSTEPS`), so that a
+    /// contact force's peak is in the history.
+    pub substeps: bool,
     /// Output directory from the deck (the command line's `-o` wins).
     pub dir: Option<String>,
     /// Also write a ParaView `.pvd` series of VTK files.
@@ -47,6 +51,7 @@ impl Default for OutputRequest {
             nodes: Selection::Default,
             elements: Selection::Default,
             every: 1,
+            substeps: false,
             dir: None,
             vtk: false,
             netcdf: false,

@@ -59,19 +59,41 @@ pub struct Sampling {
     every: u64,
     /// `n h` for fixed steps.
     period: Option<f64>,
+    /// `OUTPUT … SUBSTEPS`: also the states of steps shorter than `step` (fixed steps), or
+    /// every accepted state (adaptive).
+    #[serde(default)]
+    substeps: bool,
+    /// The deck's STEP, s (fixed steps; 0 otherwise).
+    #[serde(default)]
+    step: f64,
 }
 
 impl Sampling {
     /// The sampling a model asks for.
     pub fn of(model: &crate::model::Model) -> Self {
         let every = u64::from(model.output.every.max(1));
-        let period = match &model.analysis {
+        let (period, step) = match &model.analysis {
             crate::model::Analysis::Dynamic { step, adaptive, .. } if adaptive.is_none() => {
-                Some(*step * every as f64)
+                (Some(*step * every as f64), *step)
             }
-            _ => None,
+            _ => (None, 0.0),
         };
-        Sampling { every, period }
+        Sampling {
+            every,
+            period,
+            substeps: model.output.substeps,
+            step,
+        }
+    }
+
+    /// Every accepted state.
+    pub fn every_step() -> Self {
+        Sampling {
+            every: 1,
+            period: None,
+            substeps: false,
+            step: 0.0,
+        }
     }
 
     /// Whether the state of a snapshot is written.
@@ -79,9 +101,11 @@ impl Sampling {
         match self.period {
             Some(p) => {
                 let t = snap.integ.t;
-                snap.step == 0 || (t / p - (t / p).round()).abs() <= 1e-6
+                snap.step == 0
+                    || (t / p - (t / p).round()).abs() <= 1e-6
+                    || (self.substeps && snap.h < self.step * (1.0 - 1e-9))
             }
-            None => snap.step.is_multiple_of(self.every),
+            None => self.substeps || snap.step.is_multiple_of(self.every),
         }
     }
 }
@@ -320,10 +344,7 @@ impl Writer {
     /// instants k·h), as `OUTPUT EVERY 1` with adaptive steps does: for the sweeps, whose
     /// quantities of interest must see the impacts (`crate::sweep::runner`).
     pub fn every_accepted_step(&mut self) {
-        self.sampling = Sampling {
-            every: 1,
-            period: None,
-        };
+        self.sampling = Sampling::every_step();
     }
 
     /// The output directory.
@@ -628,6 +649,11 @@ impl Observer for Writer {
             self.write_state(snap)?;
         }
         Ok(())
+    }
+
+    /// The rows written (node accelerations, element reactions): the sampled states.
+    fn reads_reactions(&self, snap: &Snapshot) -> bool {
+        self.sampling.takes(snap)
     }
 
     fn progress(&mut self, t: f64, end: f64, stats: &Stats) {

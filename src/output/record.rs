@@ -105,10 +105,7 @@ impl Recorder {
 
     /// Records every accepted state (as [`super::Writer::every_accepted_step`]).
     pub fn every_accepted_step(&mut self) {
-        self.sampling = Sampling {
-            every: 1,
-            period: None,
-        };
+        self.sampling = Sampling::every_step();
     }
 
     fn record(&mut self, integ: &Integrator) {
@@ -195,6 +192,11 @@ impl Recorder {
 }
 
 impl Observer for Recorder {
+    /// The rows recorded (node accelerations, element reactions): the sampled states.
+    fn reads_reactions(&self, snap: &Snapshot) -> bool {
+        self.sampling.takes(snap)
+    }
+
     fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
         if self.sampling.takes(snap) {
             self.record(snap.integ);

@@ -146,6 +146,11 @@ impl Observer for VtkWriter {
         }
         Ok(())
     }
+
+    /// Positions and rotations only.
+    fn reads_reactions(&self, _snap: &Snapshot) -> bool {
+        false
+    }
 }
 
 /// The line cells of a model: (element number, dense node 1, dense node 2) for each
@@ -273,6 +278,10 @@ impl Observer for Fanout<'_> {
         for o in &mut self.0 {
             o.progress(t, end, stats);
         }
+    }
+
+    fn reads_reactions(&self, snap: &Snapshot) -> bool {
+        self.0.iter().any(|o| o.reads_reactions(snap))
     }
 
     fn pause(

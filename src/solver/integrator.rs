@@ -191,6 +191,9 @@ pub struct Integrator {
     /// The stages of the ESDIRK scheme when it replaces HHT (`model::Scheme::Esdirk3`);
     /// `None` = HHT. Scratch within a step: nothing in it is read across steps.
     esdirk: Option<Box<esdirk::Stages>>,
+    /// The index-1 solve of a stage scheme's accelerations and multipliers at each step's
+    /// end ([`multipliers`]); `None` for the α family and for models without multipliers.
+    index1: Option<Box<multipliers::Index1>>,
     /// Buffers of [`Integrator::consistent_accelerations`], kept so that the restarts of
     /// the accelerations at a contact's events allocate nothing (issue 27 §1d).
     acc: AccelerationScratch,
@@ -259,6 +262,9 @@ impl Integrator {
         let esdirk = esdirk::tableau_of(&scheme)
             .filter(|_| dynamic)
             .map(|tab| Box::new(esdirk::Stages::sized(&sys, tab)));
+        let index1 = esdirk
+            .as_ref()
+            .and_then(|_| multipliers::Index1::sized(&sys));
         Integrator {
             lu_step: f64::NAN,
             trial: nodes.clone(),
@@ -273,6 +279,7 @@ impl Integrator {
             history: Vec::with_capacity(newton.max_iterations as usize + 1),
             acc: AccelerationScratch::sized(n, n - sys.n_node_eq, nn),
             esdirk,
+            index1,
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -452,35 +459,21 @@ impl Integrator {
 }
 
 /// `nodes` moved along their velocities for a time `dt` (the geodesic `q exp(dt v)`:
-/// `x + v dt`, `R exp(dt Ω̃)`), into `out`: the points of the central differences of `Φ`
-/// along `v` (the restart's `Ḃv`, the ESDIRK stages' `B v`).
+/// `x + v dt`, `R exp(dt Ω̃)`), into `out`: the points of the restart's central second
+/// difference of `Φ` along `v` (`Ḃv`).
 fn moved_along_velocities(nodes: &[NodeState], dt: f64, out: &mut Vec<NodeState>) {
     out.clear();
-    out.extend_from_slice(nodes);
-    moved_some_along_velocities(nodes, dt, 0..nodes.len(), out);
-}
-
-/// [`moved_along_velocities`] for the nodes `which` alone, into `out` (already sized; the
-/// other nodes of `out` are left as they are).
-fn moved_some_along_velocities(
-    nodes: &[NodeState],
-    dt: f64,
-    which: impl IntoIterator<Item = usize>,
-    out: &mut [NodeState],
-) {
-    for k in which {
-        let s = &nodes[k];
-        out[k] = NodeState {
-            x: s.x + s.v * dt,
-            r: s.r * rotation::exp(&(s.w * dt)),
-            ..*s
-        };
-    }
+    out.extend(nodes.iter().map(|s| NodeState {
+        x: s.x + s.v * dt,
+        r: s.r * rotation::exp(&(s.w * dt)),
+        ..*s
+    }));
 }
 
 mod error;
 pub mod esdirk;
 mod hht;
+mod multipliers;
 mod newton;
 mod start;
 mod statics;

@@ -194,6 +194,16 @@ pub struct Snapshot<'a> {
 pub trait Observer {
     /// Called with the initial state and each accepted state. An error stops the run.
     fn state(&mut self, snap: &Snapshot) -> std::io::Result<()>;
+    /// Whether [`Observer::state`] reads this state's multipliers or accelerations (a
+    /// joint's reaction, a driver's torque, node accelerations). For a stage scheme (ESDIRK)
+    /// the run then hands it the values of the index-1 equations at the state's `(q, v)`
+    /// instead of the last stage's, which are a stage order less accurate
+    /// ([`Integrator::exact_reactions`]); this costs a factorisation, so an observer that
+    /// writes only some states (`OUTPUT … EVERY n`) or reads only positions says no for the
+    /// others. Default: yes.
+    fn reads_reactions(&self, _snap: &Snapshot) -> bool {
+        true
+    }
     /// Progress: time reached and end time.
     fn progress(&mut self, _t: f64, _end: f64, _stats: &Stats) {}
     /// A pause between two steps: after the initial state and after each accepted step,
@@ -319,6 +329,26 @@ pub(crate) const FLOOR_SLACK: f64 = 1e-3;
 /// ln(1e12)/ln(1/0.999) ≈ 27,600 refusals is the most a step can take: this bound is a
 /// guard that a broken control cannot turn into a loop without end.
 pub(crate) const MAX_REFUSALS: u32 = 100_000;
+
+/// Hands an accepted state to the observer. For a stage scheme, with the multipliers and
+/// accelerations of the index-1 equations at the state's `(q, v)` when the observer reads
+/// them ([`Observer::reads_reactions`], [`Integrator::exact_reactions`]); the stage values
+/// come back after it, so the integration does not depend on what is observed.
+pub(crate) fn observe(
+    integ: &mut Integrator,
+    obs: &mut dyn Observer,
+    step: u64,
+    h: f64,
+) -> std::io::Result<()> {
+    let exact = integ.is_esdirk()
+        && obs.reads_reactions(&Snapshot { integ, step, h })
+        && integ.exact_reactions();
+    let seen = obs.state(&Snapshot { integ, step, h });
+    if exact {
+        integ.restore_stage_values();
+    }
+    seen
+}
 
 /// The adaptive step after `h` when the error estimate proposes `proposal`: the largest
 /// rung `h₀·2^(k/4)` not above the proposal; a larger step only if that is at least two

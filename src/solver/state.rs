@@ -105,6 +105,8 @@ pub struct IntegratorState {
     tmap: Vec<[f64; 9]>,
     rhs: Vec<f64>,
     lu: LuState,
+    /// The stage schemes' index-1 solve of the reactions (its kept pivots).
+    lu_index1: Option<LuState>,
     elements: Vec<ElementState>,
     /// The energy guard's record along the run ([`crate::solver::energy_guard::Balance`]).
     balance: crate::solver::energy_guard::Balance,
@@ -181,6 +183,7 @@ impl Integrator {
             tmap: self.tmap.iter().map(arr9).collect(),
             rhs: self.sys.rhs.clone(),
             lu: self.sys.matrix.save_state(),
+            lu_index1: self.index1_lu(),
             elements: self.sys.elements.iter().map(|e| e.save_state()).collect(),
             balance: self.balance,
         })
@@ -225,6 +228,7 @@ impl Integrator {
             el.restore_state(st)?;
         }
         self.sys.matrix.restore_state(s.lu)?;
+        self.restore_index1_lu(s.lu_index1)?;
         self.t = s.t;
         self.stats = s.stats;
         for (d, r) in self.nodes.iter_mut().zip(&s.nodes) {

@@ -15,7 +15,7 @@
 
 use super::{
     Failure, FailureReason, Integrator, Interruption, LoopState, Observer, Pause, RunError,
-    RunReport, Snapshot, ladder_step,
+    RunReport, ladder_step,
 };
 use crate::model::{Analysis, Model, Scheme};
 use std::time::Instant;
@@ -104,11 +104,7 @@ impl Stepper {
             integ.stats.min_step = f64::INFINITY;
             failure = integ.initialize().err();
             if failure.is_none() {
-                obs.state(&Snapshot {
-                    integ,
-                    step: 0,
-                    h: 0.0,
-                })?;
+                super::observe(integ, obs, 0, 0.0)?;
             }
         }
         // Breakpoints of load functions: steps land on them rather than straddle a kink.
@@ -347,11 +343,8 @@ impl Stepper {
                 integ.stats.cpu_seconds = self.cpu0 + self.start.elapsed().as_secs_f64();
                 integ.stats.pivot_searches = integ.sys.matrix.pivoting_factorizations();
                 self.pause_due = true;
-                obs.state(&Snapshot {
-                    integ,
-                    step: integ.stats.steps,
-                    h: h_try,
-                })?;
+                let step = integ.stats.steps;
+                super::observe(integ, obs, step, h_try)?;
                 obs.progress(integ.t, end, &integ.stats);
                 if integ.dynamic
                     && self

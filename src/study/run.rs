@@ -22,6 +22,11 @@ pub(super) struct Recorder {
 }
 
 impl Observer for Recorder {
+    /// Positions, rotations and velocities only.
+    fn reads_reactions(&self, _snap: &Snapshot) -> bool {
+        false
+    }
+
     fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
         let integ = snap.integ;
         for (k, &i) in self.nodes.iter().enumerate() {

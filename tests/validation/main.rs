@@ -13,4 +13,5 @@ mod pendulum;
 mod refine;
 mod section_properties;
 mod slider_crank_clearance;
+mod slider_crank_driven;
 mod spinup;

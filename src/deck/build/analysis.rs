@@ -369,7 +369,9 @@ impl Builder<'_> {
         let span = card.span();
         let mut c = Cursor::new(card, "OUTPUT card");
         c.skip();
-        const KW: [&str; 6] = ["NODES", "ELEMENTS", "EVERY", "DIR", "VTK", "FORMAT"];
+        const KW: [&str; 7] = [
+            "NODES", "ELEMENTS", "EVERY", "SUBSTEPS", "DIR", "VTK", "FORMAT",
+        ];
         let mut seen = Seen::default();
         let mut out = OutputRequest::default();
         while let Some(t) = c.peek() {
@@ -436,6 +438,7 @@ impl Builder<'_> {
                     }
                     out.every = n;
                 }
+                "SUBSTEPS" => out.substeps = true,
                 "DIR" => out.dir = Some(c.next("directory after DIR")?.text.to_string()),
                 "FORMAT" => match c.keyword(&["CSV", "NETCDF"]) {
                     Some((f, _)) => out.netcdf = f == "NETCDF",

@@ -166,6 +166,35 @@ impl Element for Joint {
         self.drive.is_some()
     }
 
+    /// `B v` by one dual direction: `Φ` (joints/constraints.rs, generic) at
+    /// `x + εv`, `R(I + εΩ̃)` (exact to first order in `ε`, all a dual number carries).
+    fn constraint_rates(&self, nodes: &[NodeState], out: &mut [f64]) -> bool {
+        let m = self.m_pair();
+        let moved = |s: &NodeState| {
+            let rw = s.r * skew(&s.w);
+            (
+                Vector3::from_fn(|i, _| Dual::<1> {
+                    re: s.x[i],
+                    eps: [s.v[i]],
+                }),
+                Matrix3::from_fn(|i, j| Dual::<1> {
+                    re: s.r[(i, j)],
+                    eps: [rw[(i, j)]],
+                }),
+            )
+        };
+        for (k, pair) in self.pairs.iter().enumerate() {
+            let (x1, r1) = moved(&nodes[self.nodes[pair.a]]);
+            let (x2, r2) = moved(&nodes[self.nodes[pair.b]]);
+            // The driver's target is a constant along the motion: its value is not needed.
+            let phi = self.phi(pair, &x1, &r1, &x2, &r2, 0.0);
+            for (o, p) in out[k * m..(k + 1) * m].iter_mut().zip(&phi) {
+                *o = p.eps[0];
+            }
+        }
+        true
+    }
+
     fn constraint_time_derivatives(&self, t: f64, k: usize) -> [f64; 2] {
         match self.drive_law(t) {
             Some([_, fd, fdd]) if k == 5 => [-fd, -fdd],

@@ -193,3 +193,82 @@ fn driven_joints_tangent_matches_finite_differences() {
     let j = Joint::new(ElementId(8), JointType::Clamp, vec![0, 1], &x0).unwrap();
     assert!(j.with_drive(law()).is_err());
 }
+
+/// `B v` of [`Element::constraint_rates`] (one dual direction along the velocities) is the
+/// constraint rows of the tangent (checked against finite differences above) applied to
+/// `(v, Ω)`, divided by the scale: for every joint kind and a driven HINGE and PRISMATIC,
+/// at large rotations, to round-off (1e-12 of the rows' size).
+#[test]
+fn constraint_rates_are_the_tangents_constraint_rows_times_the_velocities() {
+    let a = Vector3::new(0.3, -0.5, 0.8).normalize();
+    let (p, q) = normals(&a);
+    let law = || {
+        crate::elements::drive::TimeLaw::new(
+            crate::model::Function::Haversine {
+                start: 0.0,
+                duration: 1.0,
+            },
+            40.0,
+        )
+    };
+    let x0 = [
+        Vector3::new(0.1, 0.2, -0.1),
+        Vector3::new(0.4, -0.1, 0.3),
+        Vector3::new(-0.2, 0.5, 0.1),
+    ];
+    let mut joints: Vec<Joint> = all_types()
+        .into_iter()
+        .map(|kind| {
+            let n = if matches!(kind, JointType::Rigid) {
+                3
+            } else {
+                2
+            };
+            Joint::new(ElementId(7), kind, (0..n).collect(), &x0[..n]).unwrap()
+        })
+        .collect();
+    for kind in [
+        JointType::Hinge { p, q, a },
+        JointType::Prismatic { p, q, a },
+    ] {
+        joints.push(
+            Joint::new(ElementId(8), kind, vec![0, 1], &x0[..2])
+                .unwrap()
+                .with_drive(law())
+                .unwrap(),
+        );
+    }
+    let c = EvalContext { t: 0.3, ..ctx() };
+    for j in &joints {
+        let n = j.nodes().len();
+        let m = j.multipliers();
+        for seed in 1..4 {
+            let st = random_states(&x0[..n], 0.3, 1.5, seed);
+            let lam = vec![0.0; m];
+            let mut local = Local::new(6 * n + m);
+            j.evaluate(&c, &st, &lam, true, &mut local);
+            let mut rates = vec![0.0; m];
+            assert!(j.constraint_rates(&st, &mut rates));
+            for (k, r) in rates.iter().enumerate() {
+                let mut bv = 0.0;
+                let mut size = 0.0f64;
+                for (i, s) in st.iter().enumerate() {
+                    for d in 0..3 {
+                        let (tx, tr) = (
+                            local.tan_at(6 * n + k, 6 * i + d),
+                            local.tan_at(6 * n + k, 6 * i + 3 + d),
+                        );
+                        bv += (tx * s.v[d] + tr * s.w[d]) / c.constraint_scale;
+                        size = size.max((tx * s.v[d]).abs()).max((tr * s.w[d]).abs());
+                    }
+                }
+                let size = size / c.constraint_scale;
+                assert!(
+                    (r - bv).abs() <= 1e-12 * size.max(1.0),
+                    "{:?} row {k}: {r} vs {bv}",
+                    j.kind()
+                );
+            }
+        }
+    }
+}

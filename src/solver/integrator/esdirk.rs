@@ -25,6 +25,10 @@
 //! up to `ωh ≈ 5` (`1 − |R(iωh)|` = 3.8e-5 at `ωh = 1`, 8.6e-3 at 5) where ESDIRK3 damps
 //! them (1.8e-2 at 1, 0.48 at 5).
 //!
+//! The last stage's multipliers (and accelerations) are only second order (the stage
+//! order): the rows a run writes carry those of the index-1 equations at the state's
+//! `(q, v)` instead, computed for the observer alone ([`super::multipliers`]).
+//!
 //! Stage 1 is the start state itself: its accelerations are the consistent ones the last
 //! stage of the previous step (or [`Integrator::consistent_accelerations`] at a start or
 //! a contact's restart) solved, so the scheme is one-step in `(q, v)` and keeps no history
@@ -78,38 +82,17 @@ pub struct Stages {
     /// The scheme's coefficients.
     tab: &'static Tableau,
     /// Whether the stage being solved meets its constraints at the velocity level (module
-    /// docs: the inner stages), with their rows `s γh B(q_i) v_i` in `rows`.
+    /// docs: the inner stages), with their rows `s γh (B(q_i) v_i + ∂Φ/∂t)` in `rows`.
     velocity_level: bool,
     rows: Vec<f64>,
-    /// The central difference's `ε` of the stage being solved, chosen at its first
-    /// iteration and kept, so that the rows are one function of Newton's iterate within a
-    /// stage (NaN: not chosen yet).
-    eps: f64,
-    /// The nodes of the elements with multipliers (the joints), each once.
-    joint_nodes: Vec<usize>,
-    /// Whether an element's constraint depends on time (a driver): its `∂Φ/∂t` enters the
-    /// inner stages' velocity rows.
-    rheonomic: bool,
-    /// Scratch of the time difference of the rows.
-    time_rows: Vec<f64>,
-    /// The trial nodes moved along their velocities by ±ε (central difference of `Φ`);
-    /// only the joints' nodes are moved and read.
-    plus: Vec<NodeState>,
-    minus: Vec<NodeState>,
+    /// The exact `s B v` of the constrained elements (the joints, drivers, rigid bars).
+    bv: super::multipliers::ConstraintVelocity,
 }
 
 impl Stages {
     pub(super) fn sized(sys: &System, tab: &'static Tableau) -> Self {
         let nodes = sys.x0.len();
         let z = [Vector3::zeros(); 2];
-        let mut joint_nodes: Vec<usize> = sys
-            .elements
-            .iter()
-            .filter(|e| e.multipliers() > 0)
-            .flat_map(|e| e.nodes().iter().copied())
-            .collect();
-        joint_nodes.sort_unstable();
-        joint_nodes.dedup();
         Stages {
             vel: vec![[z; S]; nodes],
             acc: vec![[z; S]; nodes],
@@ -119,12 +102,7 @@ impl Stages {
             tab,
             velocity_level: false,
             rows: Vec::new(),
-            eps: f64::NAN,
-            joint_nodes,
-            rheonomic: sys.elements.iter().any(|e| e.rheonomic()),
-            time_rows: Vec::new(),
-            plus: Vec::with_capacity(nodes),
-            minus: Vec::with_capacity(nodes),
+            bv: super::multipliers::ConstraintVelocity::new(sys),
         }
     }
 }
@@ -236,7 +214,6 @@ impl Integrator {
                 .as_deref_mut()
                 .expect("ESDIRK stages")
                 .velocity_level = i < last;
-            self.esdirk.as_deref_mut().expect("ESDIRK stages").eps = f64::NAN;
             let (iter, rel, history, fref) = self.newton_solve(h, &ctx, Kinematics::Stage)?;
             if i == last {
                 let mut info = self.finish_step(h, &ctx, iter, rel, history, fref)?;
@@ -284,11 +261,17 @@ impl Integrator {
         }
     }
 
-    /// The constraint rows of an inner stage, `s γh (B(q_i) v_i + ∂Φ/∂t)` (module docs), into the
-    /// stages' `rows`: `B v` is the derivative of `Φ` along `q exp(εv)`, by a central
-    /// difference with `ε|v| = 1e-4 L_ref` (truncation `ε²|v|³Φ‴/6`: 1e-8 of `|v|` for a
-    /// constraint of curvature 1/L_ref; round-off `ε_mach L_ref/ε`: 1e-12 of `|v|`).
-    /// Nothing for HHT or the last stage.
+    /// The constraint rows of an inner stage, `s γh (B(q_i) v_i + ∂Φ/∂t)` (module docs), into
+    /// the stages' `rows`, exact: `B v` the elements' directional derivative of `Φ` along
+    /// `(v, Ω)` ([`super::multipliers::ConstraintVelocity`]), `∂Φ/∂t` the drivers' own
+    /// ([`crate::elements::Element::constraint_time_derivatives`]). Nothing for HHT or the
+    /// last stage.
+    ///
+    /// (Until issue 34 `B v` was a central difference of `Φ` along `q exp(±εv)` with
+    /// `ε|v| = 1e-4 L_ref`: its truncation, ~2e-9 of `|v|`, left each inner stage off the
+    /// constraint by ~2e-9 |v| γh, which the last stage's position-level rows took back with
+    /// a force ∝ 1/h — the driven slider-crank's torque error with ESDIRK5 doubled as h
+    /// halved, 1.3e-4 N·m at h = 1e-3 s and 1.05e-3 N·m at 1.25e-4 s, docs/accuracy.md.)
     pub(super) fn stage_velocity_rows(&mut self, ctx: &EvalContext) {
         let nn = self.sys.n_node_eq;
         let n = self.sys.n_eq();
@@ -298,80 +281,18 @@ impl Integrator {
         if !st.velocity_level || n == nn {
             return;
         }
-        let l = self.sys.ref_length;
-        let vmax = self
-            .trial
-            .iter()
-            .fold(0.0f64, |m, s| m.max(s.v.norm() / l).max(s.w.norm()));
         st.rows.clear();
         st.rows.resize(n - nn, 0.0);
-        // `B v`: the nodes moved along their velocities by ±ε at the stage's time, ε|v| =
-        // 1e-4 L_ref. A driver's `∂Φ/∂t`: a central difference in time alone, over
-        // ±ε_t = ±1e-2 γh, so that it reads the driver's law where the stage is (moving
-        // time with the state by ε, as until this session, read a HAVERSINE law up to
-        // seconds past its end near rest, where it is flat: driven_arm.dat's velocities were
-        // 0.74 m/s off; one ε for both, capped, either stalled Newton on round-off — ε|v| of
-        // 1e-8 m — or kept a truncation error of 1e-3 m/s). Truncation of the time part
-        // (1e-2 γh)² f‴/6; its round-off ε_mach |f|/ε_t, 1e-7 of the rate at t = 10 s for
-        // h = 1e-5 s.
-        let eps0 = if vmax > 0.0 { 1e-4 / vmax } else { 0.0 };
-        if st.eps.is_nan() {
-            st.eps = eps0;
-        }
-        let eps = st.eps;
-        let at = |dt: f64| EvalContext {
-            t: ctx.t + dt,
-            ..*ctx
-        };
-        // The constraint rows alone: the elements without multipliers (beams, contacts)
-        // are not evaluated at the moved states (and a contact's per-attempt memory is not
-        // touched by evaluations at other times).
-        if eps > 0.0 {
-            // Only the joints' nodes move: the rows are the joints' alone.
-            if st.plus.len() != self.trial.len() {
-                st.plus.clone_from(&self.trial);
-                st.minus.clone_from(&self.trial);
-            }
-            moved_some_along_velocities(
-                &self.trial,
-                eps,
-                st.joint_nodes.iter().copied(),
-                &mut st.plus,
-            );
-            moved_some_along_velocities(
-                &self.trial,
-                -eps,
-                st.joint_nodes.iter().copied(),
-                &mut st.minus,
-            );
-            self.sys
-                .assemble_constraint_rows(&at(0.0), &st.plus, &self.trial_lambda);
-            st.rows.copy_from_slice(&self.sys.rhs[nn..]);
-            self.sys
-                .assemble_constraint_rows(&at(0.0), &st.minus, &self.trial_lambda);
-            let c = st.gh / (2.0 * eps);
-            for (r, m) in st.rows.iter_mut().zip(&self.sys.rhs[nn..]) {
-                *r = (*r - m) * c;
-            }
-        }
-        if st.rheonomic {
-            let et = 1e-2 * st.gh;
-            self.sys
-                .assemble_constraint_rows(&at(et), &self.trial, &self.trial_lambda);
-            st.time_rows.clear();
-            st.time_rows.extend_from_slice(&self.sys.rhs[nn..]);
-            self.sys
-                .assemble_constraint_rows(&at(-et), &self.trial, &self.trial_lambda);
-            let c = st.gh / (2.0 * et);
-            for ((r, p), m) in st
-                .rows
-                .iter_mut()
-                .zip(&st.time_rows)
-                .zip(&self.sys.rhs[nn..])
-            {
-                *r += (p - m) * c;
-            }
-        }
+        st.bv.rows(
+            &self.sys,
+            ctx,
+            &self.trial,
+            &self.trial_lambda,
+            true,
+            &mut st.rows,
+        );
+        let gh = st.gh;
+        st.rows.iter_mut().for_each(|r| *r *= gh);
     }
 
     /// Puts the rows of [`Self::stage_velocity_rows`] in place of `s Φ(q_i)` in the

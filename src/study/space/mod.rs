@@ -140,6 +140,11 @@ struct GridRecorder {
 }
 
 impl Observer for GridRecorder {
+    /// Positions, rotations and velocities only.
+    fn reads_reactions(&self, _snap: &Snapshot) -> bool {
+        false
+    }
+
     fn state(&mut self, snap: &Snapshot) -> io::Result<()> {
         let integ = snap.integ;
         let k = integ.t / self.dt;
