@@ -38,17 +38,20 @@ from scenes import SCENES, deck_text  # noqa: E402
 
 
 # ------------------------------------------------------------------------- reading runs
-def load_nodes(d, nodes):
-    """{node: (t, x, v)} from a mecano-rs output directory."""
+def load_nodes(d, nodes, acceleration=False):
+    """{node: (t, x, v)} from a mecano-rs output directory (with acceleration: (t, a, None))."""
     out = {}
     for n in nodes:
         t, x, v = [], [], []
         with open(os.path.join(d, f"node_{n}.csv")) as f:
             for row in csv.DictReader(f):
                 t.append(float(row["t"]))
-                x.append([float(row[k]) for k in ("x", "y", "z")])
-                v.append([float(row[k]) for k in ("vx", "vy", "vz")])
-        out[n] = (t, x, v)
+                if acceleration:
+                    x.append([float(row[k]) for k in ("ax", "ay", "az")])
+                else:
+                    x.append([float(row[k]) for k in ("x", "y", "z")])
+                    v.append([float(row[k]) for k in ("vx", "vy", "vz")])
+        out[n] = (t, x, v or None)
     return out
 
 
@@ -72,7 +75,7 @@ def hermite(ref, t):
 def mecano_channels(scene, d):
     """[(t, [channel vectors])] of a mecano-rs run."""
     sc = SCENES[scene]
-    nodes = load_nodes(d, sc["nodes"])
+    nodes = load_nodes(d, sc["nodes"], sc.get("acceleration", False))
     ts = nodes[sc["nodes"][0]][0]
     rows = []
     for i, t in enumerate(ts):
@@ -198,7 +201,10 @@ def run_exudyn(scene, n, h, out):
     except (IndexError, ValueError, KeyError):
         rec.update(ok=False, cpu=None, steps=None, newton=None)
     if not rec["ok"]:
-        rec["why"] = ((p.stderr or p.stdout).strip().splitlines() or ["failed"])[-1][:200]
+        if rec.get("steps") is not None:
+            rec["why"] = f"Exudyn stopped at t = {j['t_reached']:.4g} s (Newton did not converge; fixed step)"
+        else:
+            rec["why"] = ((p.stderr or p.stdout).strip().splitlines() or ["failed"])[-1][:200]
     rec["csv"] = csvp
     return rec
 

@@ -183,7 +183,7 @@ def cantilever(mbs, n):
                                 loadVectorUserFunction=lambda mbs_, t, load: [0, 0, 50.0 * f(t)]))
     sens = [mbs.AddSensor(SensorNode(nodeNumber=nd, storeInternal=True, outputVariableType=POS))
             for nd in (leg1[-1], leg2[-1])]
-    return (lambda mbs_: join(stored(mbs_, s) for s in sens)), dict(rho=1.0, abstol=1e-8)
+    return (lambda mbs_: join(stored(mbs_, s) for s in sens)), dict(rho=1.0, abstol=1e-6)
 
 
 # ------------------------------------------------------------------- Kane's spin-up beam
@@ -217,7 +217,7 @@ def spinup(mbs, n):
         th = np.array([spinup_angle(t) for t in d[:, 0]])
         return np.column_stack([d[:, 0], -d[:, 1] * np.sin(th) + d[:, 2] * np.cos(th)])
 
-    return columns, dict(rho=0.9, abstol=1e-6)
+    return columns, dict(rho=0.9, abstol=1e-5)
 
 
 # -------------------------------------------------------------- flexible slider-crank
@@ -263,7 +263,7 @@ def slider_crank(mbs, n):
         wv = np.sum((m[:, 1:3] - 0.5 * (a[:, 1:3] + b[:, 1:3])) * nrm, axis=1)
         return np.column_stack([a[:, 0], wv])
 
-    return columns, dict(rho=0.9, abstol=1e-9)
+    return columns, dict(rho=0.9, abstol=1e-6)
 
 
 BUILDERS = dict(pendulum=pendulum, cantilever=cantilever, spinup=spinup, slider_crank=slider_crank)

@@ -48,11 +48,15 @@ def slider_x(t, pos):
     return [[pos[8][0]]]
 
 
-def ideal_slider_x(t, r=0.05, l=0.12, w=5000 * 2 * 3.141592653589793 / 60):
-    """The rigid slider-crank's slider position at constant crank speed: r cos(theta) +
-    sqrt(l^2 - r^2 sin^2(theta)), theta = w t (decks/benchmarks/slider_crank_ideal.dat)."""
+def ideal_slider_a(t, r=0.05, l=0.12, w=5000 * 2 * 3.141592653589793 / 60):
+    """The rigid slider-crank's slider acceleration at constant crank speed w, theta = w t
+    (decks/benchmarks/slider_crank_ideal.dat): x = r cos(theta) + S, S = sqrt(l^2 - r^2
+    sin^2(theta)), so x'' = w^2 (-r cos(theta) - r^2 cos(2 theta)/S - r^4 sin^2(theta)
+    cos^2(theta)/S^3), which is -r w^2 (1 + r/l) at theta = 0."""
     th = w * t
-    return [[r * math.cos(th) + math.sqrt(l * l - (r * math.sin(th)) ** 2)]]
+    s, c = math.sin(th), math.cos(th)
+    S = math.sqrt(l * l - (r * s) ** 2)
+    return [[w * w * (-r * c - r * r * math.cos(2 * th) / S - r ** 4 * (s * c) ** 2 / S ** 3)]]
 
 
 def mk(label, h, d, p, scheme, beams=1, per=""):
@@ -113,7 +117,9 @@ SCENES = {
                 leg(0.1, 1, 6, "ESDIRK5"),
                 leg(0.1, 1, 8, "ESDIRK5"),
                 leg(0.1, 2, 6, "ESDIRK5"),
-                leg(0.05, 2, 6, "ESDIRK5")],
+                leg(0.05, 2, 6, "ESDIRK5"),
+                leg(0.025, 1, 6, "ALPHA 0"),
+                leg(0.0375, 1, 6, "ALPHA 0")],
         exudyn=[(10, 0.05), (20, 0.05), (40, 0.05), (40, 0.025), (80, 0.025), (80, 0.0125)],
     ),
     "spinup": dict(
@@ -127,6 +133,10 @@ SCENES = {
         mecano=[mk("the deck: 10 two-node, HHT -0.05, h = 0.01", 0.01, 10, 1, "ALPHA -0.05"),
                 mk(None, 0.005, 10, 1, "ALPHA -0.05"),
                 mk(None, 0.01, 20, 1, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 4, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 6, "ALPHA -0.05"),
+                mk(None, 0.0125, 1, 6, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 6, "GENALPHA RHOINF 0.9"),
                 mk(None, 0.04, 3, 6, "ESDIRK5"),
                 mk(None, 0.02, 3, 6, "ESDIRK5"),
                 mk(None, 0.04, 2, 8, "ESDIRK5"),
@@ -145,8 +155,11 @@ SCENES = {
                 rod(8e-5, 1, 4, "ESDIRK5"),
                 rod(4e-5, 1, 4, "ESDIRK5"),
                 rod(8e-5, 1, 2, "ESDIRK5"),
-                rod(4e-5, 1, 6, "ESDIRK5")],
-        exudyn=[(8, 1e-5), (16, 1e-5), (16, 5e-6), (32, 5e-6), (64, 2.5e-6)],
+                rod(4e-5, 1, 6, "ESDIRK5"),
+                rod(4e-5, 1, 4, "ALPHA 0"),
+                rod(1.6e-4, 1, 3, "ESDIRK5"),
+                rod(2.4e-4, 1, 4, "ESDIRK5")],
+        exudyn=[(8, 1e-5), (16, 1e-5), (32, 1e-5), (32, 5e-6), (64, 5e-6), (128, 2.5e-6)],
     ),
     "four_bar": dict(
         title="Bauchau's spatial four-bar, t <= 2.5 s (before the first flattened position), "
@@ -163,25 +176,30 @@ SCENES = {
                 bar4(0.02, 1, 2, "GENALPHA RHOINF 0")],
     ),
     "slider_crank_ideal": dict(
-        title="Flores & Ambrosio's slider-crank, ideal joints, 5000 rpm, two turns (0.024 s), the slider's position",
+        title="Flores & Ambrosio's slider-crank, ideal joints, 5000 rpm, two turns (0.024 s), the slider's "
+              "acceleration (its position is exact at any step: one degree of freedom, driven)",
         deck="decks/benchmarks/slider_crank_ideal.dat", mesh_re=None, tend=0.024, period=1e-4,
-        nodes=[8], widths=[1], channels=slider_x, exact=ideal_slider_x,
+        nodes=[8], widths=[1], channels=slider_x, exact=ideal_slider_a, acceleration=True,
         mecano=[mk("the deck: rigid, HHT -0.05, h = 1e-5", 1e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 2e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 5e-5, 1, 1, "ALPHA -0.05"),
                 mk(None, 1e-4, 1, 1, "ALPHA -0.05"),
-                mk(None, 2e-4, 1, 1, "ALPHA -0.05"),
+                mk(None, 1e-4, 1, 1, "ESDIRK5"),
                 mk(None, 2e-4, 1, 1, "ESDIRK5"),
-                mk(None, 4e-4, 1, 1, "ESDIRK5"),
-                mk(None, 8e-4, 1, 1, "ESDIRK5")],
+                mk(None, 4e-4, 1, 1, "ESDIRK5")],
     ),
     "slider_crank_clearance": dict(
-        title="Flores & Ambrosio's slider-crank with a revolute clearance, 5000 rpm, two turns (0.024 s), the slider's position",
-        deck="decks/benchmarks/slider_crank_clearance.dat", mesh_re=None, tend=0.024, period=1e-4,
+        title="Flores & Ambrosio's slider-crank with a revolute clearance, 5000 rpm, t <= 4 ms (after it the "
+              "impact sequence depends on the step: docs/benchmarks.md), the slider's position",
+        deck="decks/benchmarks/slider_crank_clearance.dat", mesh_re=None, tend=0.004, period=1e-4,
         nodes=[8], widths=[1], channels=slider_x,
         ref=mk("reference: rigid, HHT -0.05, h = 1.25e-6", 1.25e-6, 1, 1, "ALPHA -0.05"),
         check=mk("check: rigid, HHT -0.05, h = 2.5e-6", 2.5e-6, 1, 1, "ALPHA -0.05"),
         mecano=[mk("the deck: rigid, HHT -0.05, h = 1e-5", 1e-5, 1, 1, "ALPHA -0.05"),
                 mk(None, 2e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 4e-5, 1, 1, "ALPHA -0.05"),
                 mk(None, 5e-6, 1, 1, "ALPHA -0.05"),
+                mk(None, 4e-5, 1, 1, "ESDIRK5"),
                 mk(None, 2e-5, 1, 1, "ESDIRK5"),
                 mk(None, 1e-5, 1, 1, "ESDIRK5")],
     ),
