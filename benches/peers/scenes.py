@@ -1,0 +1,224 @@
+"""The scenes of the peer bench: mecano-rs's deck and its variants, the compared quantities,
+the reference, and each code's ladder (benches/peers/README.md). Standard library only.
+
+A mecano-rs configuration is made from the scene's deck by changing three cards, as
+benches/converged_deck.sh does: the beams' mesh (DIVIDE d ORDER p on the scene's BEAM
+cards), the ANALYSIS card (integrator, step, end) and the OUTPUT interval.
+"""
+import math
+import os
+import re
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def positions(nodes):
+    return lambda t, pos: [pos[n] for n in nodes]
+
+
+def spinup_angle(t, ws=4.0, T=15.0):
+    """The hub's angle of decks/benchmarks/spinup.dat (omega_s = 4 rad/s)."""
+    if t <= T:
+        return ws / T * (t * t / 2 + (T / (2 * math.pi)) ** 2 * (math.cos(2 * math.pi * t / T) - 1))
+    return ws * (t - T / 2)
+
+
+def spinup_v(t, pos):
+    """The tip's deflection in the rotating frame, -x sin(theta) + y cos(theta) of node 3."""
+    th = spinup_angle(t)
+    x, y, _ = pos[3]
+    return [[-x * math.sin(th) + y * math.cos(th)]]
+
+
+def midspan_w(t, pos):
+    """The rod's mid-span deflection: node 12 minus the chord's midpoint (nodes 10, 14) on
+    the normal z x chord (docs/benchmarks.md, "Flexible slider-crank")."""
+    a, m, b = pos[10], pos[12], pos[14]
+    cx, cy = b[0] - a[0], b[1] - a[1]
+    ln = math.hypot(cx, cy)
+    nx, ny = -cy / ln, cx / ln
+    return [[(m[0] - 0.5 * (a[0] + b[0])) * nx + (m[1] - 0.5 * (a[1] + b[1])) * ny]]
+
+
+def node_z(nodes):
+    return lambda t, pos: [[pos[n][2]] for n in nodes]
+
+
+def slider_x(t, pos):
+    return [[pos[8][0]]]
+
+
+def ideal_slider_a(t, r=0.05, l=0.12, w=5000 * 2 * 3.141592653589793 / 60):
+    """The rigid slider-crank's slider acceleration at constant crank speed w, theta = w t
+    (decks/benchmarks/slider_crank_ideal.dat): x = r cos(theta) + S, S = sqrt(l^2 - r^2
+    sin^2(theta)), so x'' = w^2 (-r cos(theta) - r^2 cos(2 theta)/S - r^4 sin^2(theta)
+    cos^2(theta)/S^3), which is -r w^2 (1 + r/l) at theta = 0."""
+    th = w * t
+    s, c = math.sin(th), math.cos(th)
+    S = math.sqrt(l * l - (r * s) ** 2)
+    return [[w * w * (-r * c - r * r * math.cos(2 * th) / S - r ** 4 * (s * c) ** 2 / S ** 3)]]
+
+
+def mk(label, h, d, p, scheme, beams=1, per=""):
+    """A mecano-rs configuration: every BEAM card of the scene divided into d beams of order p
+    (`beams` BEAM cards per bar, leg or rod, named by `per`), scheme and step h."""
+    n = d * beams
+    mesh = (f"{n} x order {p}" if p > 1 else f"{n} two-node") + per if d * p > 1 or per else "rigid bodies"
+    return dict(label=label or f"{mesh}, {scheme}, h = {h:g}", h=h, d=d, p=p, mesh=mesh, scheme=scheme)
+
+
+def pend(h, d, p, scheme, label=None):
+    return mk(label, h, d, p, scheme, 1, " per bar")
+
+
+def leg(h, d, p, scheme, label=None):
+    return mk(label, h, d, p, scheme, 1, " per leg")
+
+
+def rod(h, d, p, scheme, label=None):
+    return mk(label, h, d, p, scheme, 4, " in the rod")
+
+
+def bar4(h, d, p, scheme, label=None):
+    return mk(label, h, d, p, scheme, 2, " per bar")
+
+
+# The ladders. mecano-rs: (label, h, divisions, order, ANALYSIS scheme); Exudyn: (beams per
+# bar/leg/beam/rod, h). The first mecano-rs rung of each scene is the deck as shipped.
+SCENES = {
+    "pendulum": dict(
+        title="seed's double pendulum striking the floor (flexible1), t <= 1.5 s, nodes 12 and 23",
+        deck="decks/pendulum_converged.dat", mesh_re=r"ORDER 8", tend=1.5, period=1e-3,
+        nodes=[12, 23], widths=[3, 3], channels=positions([12, 23]), target=1e-3,
+        ref=pend(3.90625e-5, 2, 8, "ESDIRK5", "reference: 2 x order 8 per bar, ESDIRK5, h = 3.90625e-5"),
+        check=pend(7.8125e-5, 2, 8, "ESDIRK5", "check: 2 x order 8 per bar, ESDIRK5, h = 7.8125e-5"),
+        mecano=[pend(3.90625e-4, 1, 8, "ESDIRK5", "decks/pendulum_converged.dat: 1 x order 8 per bar, ESDIRK5, h = 3.90625e-4"),
+                pend(7.8125e-4, 1, 8, "ESDIRK5"),
+                pend(1.953125e-4, 1, 8, "ESDIRK5"),
+                pend(3.90625e-4, 1, 10, "ESDIRK5"),
+                pend(2.6041666666666666e-4, 1, 10, "ESDIRK5"),
+                pend(1.953125e-4, 1, 10, "ESDIRK5"),
+                pend(3.90625e-4, 2, 8, "ESDIRK5"),
+                pend(1.5625e-5, 1, 8, "ALPHA -0.1")],
+        exudyn=[(10, 1e-4), (10, 5e-5), (20, 5e-5), (40, 5e-5), (40, 2.5e-5)],
+    ),
+    "cantilever": dict(
+        title="right-angle cantilever (Simo & Vu-Quoc 1988), t <= 30 s, elbow and tip",
+        deck="decks/benchmarks/right_angle_cantilever.dat", mesh_re=r"DIVIDE \$n", tend=30.0, period=0.1,
+        nodes=[2, 3], widths=[3, 3], channels=positions([2, 3]),
+        ref=leg(0.0125, 4, 8, "ESDIRK5", "reference: 4 x order 8 per leg, ESDIRK5, h = 0.0125"),
+        check=leg(0.025, 2, 8, "ESDIRK5", "check: 2 x order 8 per leg, ESDIRK5, h = 0.025"),
+        mecano=[leg(0.05, 10, 1, "ALPHA 0", "the deck: 10 two-node per leg, HHT 0, h = 0.05"),
+                leg(0.05, 40, 1, "ALPHA 0"),
+                leg(0.025, 40, 1, "ALPHA 0"),
+                leg(0.2, 2, 6, "ESDIRK5"),
+                leg(0.125, 1, 6, "ESDIRK5"),
+                leg(0.125, 1, 8, "ESDIRK5"),
+                leg(0.1, 1, 6, "ESDIRK5"),
+                leg(0.1, 1, 8, "ESDIRK5"),
+                leg(0.1, 2, 6, "ESDIRK5"),
+                leg(0.05, 2, 6, "ESDIRK5"),
+                leg(0.025, 1, 6, "ALPHA 0"),
+                leg(0.0375, 1, 6, "ALPHA 0")],
+        exudyn=[(10, 0.05), (20, 0.05), (40, 0.05), (40, 0.025), (80, 0.025), (80, 0.0125)],
+    ),
+    "spinup": dict(
+        title="Kane's spin-up beam, omega_s = 4 rad/s, t <= 20 s, tip deflection in the rotating frame",
+        deck="decks/benchmarks/spinup.dat", mesh_re=r"DIVIDE \$n", tend=20.0, period=0.1,
+        nodes=[3], widths=[1], channels=spinup_v,
+        ref=mk("reference: 4 x order 8, ESDIRK5, h = 2.5e-3", 2.5e-3, 4, 8, "ESDIRK5"),
+        check=mk("check: 2 x order 8, ESDIRK5, h = 5e-3", 5e-3, 2, 8, "ESDIRK5"),
+        # (1 x order 6, 1 x order 8, 2 x order 6 and 4 x order 4 with ESDIRK5 stop at t = 0:
+        # Newton stagnates on the driver's row, docs/benchmarks.md)
+        mecano=[mk("the deck: 10 two-node, HHT -0.05, h = 0.01", 0.01, 10, 1, "ALPHA -0.05"),
+                mk(None, 0.005, 10, 1, "ALPHA -0.05"),
+                mk(None, 0.01, 20, 1, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 4, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 6, "ALPHA -0.05"),
+                mk(None, 0.0125, 1, 6, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 6, "GENALPHA RHOINF 0.9"),
+                mk(None, 0.04, 3, 6, "ESDIRK5"),
+                mk(None, 0.02, 3, 6, "ESDIRK5"),
+                mk(None, 0.04, 2, 8, "ESDIRK5"),
+                mk(None, 0.02, 2, 8, "ESDIRK5")],
+        exudyn=[(10, 0.01), (20, 0.01), (20, 0.005), (40, 0.005), (80, 0.0025)],
+    ),
+    "slider_crank": dict(
+        title="flexible slider-crank (Song & Haug 1980), t <= 0.06 s, the rod's mid-span deflection",
+        deck="decks/benchmarks/slider_crank_flexible.dat", mesh_re=r"ORDER 4", tend=0.06, period=1e-4,
+        nodes=[10, 12, 14], widths=[1], channels=midspan_w,
+        ref=rod(2.5e-6, 2, 8, "ESDIRK5", "reference: 8 x order 8 in the rod, ESDIRK5, h = 2.5e-6"),
+        check=rod(5e-6, 1, 8, "ESDIRK5", "check: 4 x order 8 in the rod, ESDIRK5, h = 5e-6"),
+        mecano=[rod(1e-5, 1, 4, "ALPHA 0", "the deck: 4 x order 4 in the rod, HHT 0, h = 1e-5"),
+                rod(2e-5, 1, 4, "ALPHA 0"),
+                rod(1.6e-4, 1, 4, "ESDIRK5"),
+                rod(8e-5, 1, 4, "ESDIRK5"),
+                rod(4e-5, 1, 4, "ESDIRK5"),
+                rod(8e-5, 1, 2, "ESDIRK5"),
+                rod(4e-5, 1, 6, "ESDIRK5"),
+                rod(4e-5, 1, 4, "ALPHA 0"),
+                rod(1.6e-4, 1, 3, "ESDIRK5"),
+                rod(2.4e-4, 1, 4, "ESDIRK5")],
+        exudyn=[(8, 1e-5), (16, 1e-5), (32, 1e-5), (32, 5e-6), (64, 5e-6), (128, 2.5e-6)],
+    ),
+    "four_bar": dict(
+        title="Bauchau's spatial four-bar, t <= 2.5 s (before the first flattened position), "
+              "out-of-plane displacement of the three mid-spans",
+        deck="decks/benchmarks/four_bar_bauchau.dat", mesh_re=r"ORDER \$p", tend=2.5, period=0.01,
+        nodes=[11, 21, 31], widths=[1, 1, 1], channels=node_z([11, 21, 31]),
+        ref=bar4(1.25e-3, 2, 8, "ESDIRK5", "reference: 4 x order 8 per bar, ESDIRK5, h = 1.25e-3"),
+        check=bar4(2.5e-3, 1, 8, "ESDIRK5", "check: 2 x order 8 per bar, ESDIRK5, h = 2.5e-3"),
+        mecano=[bar4(0.01, 1, 4, "GENALPHA RHOINF 0", "the deck: 2 x order 4 per bar, generalized-alpha 0, h = 0.01"),
+                bar4(0.02, 1, 4, "GENALPHA RHOINF 0"),
+                bar4(0.05, 1, 4, "GENALPHA RHOINF 0"),
+                bar4(0.05, 1, 4, "ESDIRK5"),
+                bar4(0.02, 1, 4, "ESDIRK5"),
+                bar4(0.02, 1, 2, "GENALPHA RHOINF 0")],
+    ),
+    "slider_crank_ideal": dict(
+        title="Flores & Ambrosio's slider-crank, ideal joints, 5000 rpm, two turns (0.024 s), the slider's "
+              "acceleration (its position is exact at any step: one degree of freedom, driven)",
+        deck="decks/benchmarks/slider_crank_ideal.dat", mesh_re=None, tend=0.024, period=1e-4,
+        nodes=[8], widths=[1], channels=slider_x, exact=ideal_slider_a, acceleration=True,
+        mecano=[mk("the deck: rigid, HHT -0.05, h = 1e-5", 1e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 2e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 5e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 1e-4, 1, 1, "ALPHA -0.05"),
+                mk(None, 1e-4, 1, 1, "ESDIRK5"),
+                mk(None, 2e-4, 1, 1, "ESDIRK5"),
+                mk(None, 4e-4, 1, 1, "ESDIRK5")],
+    ),
+    "slider_crank_clearance": dict(
+        title="Flores & Ambrosio's slider-crank with a revolute clearance, 5000 rpm, t <= 4 ms (after it the "
+              "impact sequence depends on the step: docs/benchmarks.md), the slider's position",
+        deck="decks/benchmarks/slider_crank_clearance.dat", mesh_re=None, tend=0.004, period=1e-4,
+        nodes=[8], widths=[1], channels=slider_x,
+        ref=mk("reference: rigid, HHT -0.05, h = 1.25e-6", 1.25e-6, 1, 1, "ALPHA -0.05"),
+        check=mk("check: rigid, HHT -0.05, h = 2.5e-6", 2.5e-6, 1, 1, "ALPHA -0.05"),
+        mecano=[mk("the deck: rigid, HHT -0.05, h = 1e-5", 1e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 2e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 4e-5, 1, 1, "ALPHA -0.05"),
+                mk(None, 5e-6, 1, 1, "ALPHA -0.05"),
+                mk(None, 4e-5, 1, 1, "ESDIRK5"),
+                mk(None, 2e-5, 1, 1, "ESDIRK5"),
+                mk(None, 1e-5, 1, 1, "ESDIRK5")],
+    ),
+}
+
+
+def deck_text(scene, cfg, dense=False):
+    """The scene's deck with cfg's mesh, integrator, step and output interval."""
+    sc = SCENES[scene]
+    text = open(os.path.join(ROOT, sc["deck"])).read()
+    mesh = (f"DIVIDE {cfg['d']} " if cfg["d"] > 1 else "") + (f"ORDER {cfg['p']}" if cfg["p"] > 1 else "")
+    lines = []
+    for line in text.splitlines():
+        if sc["mesh_re"] and re.match(r"^\s*\d+(\s+TO\s+\d+)?\s+BEAM\b", line) and re.search(sc["mesh_re"], line):
+            line = re.sub(sc["mesh_re"], mesh.strip() or "DIVIDE 1", line)
+        if line.startswith("ANALYSIS DYNAMIC"):
+            line = f"ANALYSIS DYNAMIC {cfg['scheme']} STEP {cfg['h']!r} END {sc['tend']!r}"
+        if line.startswith("OUTPUT"):
+            every = 1 if dense else max(1, int(math.floor(sc["period"] / cfg["h"] + 1e-9)))
+            line = re.sub(r"\s+EVERY\s+\d+", "", line) + f" EVERY {every}"
+        lines.append(line)
+    return "\n".join(lines) + "\n"
