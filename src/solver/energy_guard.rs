@@ -73,6 +73,8 @@ pub struct Measure {
     pub play: f64,
     /// `T`, J.
     pub kinetic: f64,
+    /// `U`, J.
+    pub strain: f64,
     /// `E_osc = T + |U|`, J: the energy of the oscillations about the gravity field (the
     /// gravity potential is left out: it is relative to a datum, the initial configuration).
     pub osc: f64,
@@ -124,6 +126,7 @@ pub fn measure(sys: &System, nodes: &[NodeState], t: f64) -> Measure {
         energy: kinetic + u + g,
         play: kinetic.abs() + u.abs() + g.abs(),
         kinetic,
+        strain: u,
         osc: kinetic.abs() + u.abs(),
         p_ext: sys.external_power(t, nodes),
         p_damp: sys.elements.iter().map(|e| e.dissipated_power(nodes)).sum(),

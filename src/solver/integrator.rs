@@ -165,6 +165,10 @@ pub struct Integrator {
     /// Steps no longer than this are never refused by [`crate::elements::Element::step_limit`] (the run's
     /// smallest step), so a refusal cannot repeat forever.
     pub event_floor: f64,
+    /// Whether the step being finished crosses an event an element asked to land on, which
+    /// the smallest step (`event_floor`) could not (its refusal waived): the energy guard
+    /// then allows the step's change of the stored energy (`Integrator::finish_step`).
+    pub(super) straddled: bool,
     /// Set (from another thread, e.g. a signal handler's) to give up the step under way
     /// at its next Newton iteration ([`FailureReason::Aborted`]); the state is then left
     /// as a failed attempt leaves it. `None` = never.
@@ -297,6 +301,7 @@ impl Integrator {
             adaptive: None,
             error_next: f64::INFINITY,
             event_floor: 0.0,
+            straddled: false,
             abort: None,
             redundancy: Default::default(),
             notices: Vec::new(),

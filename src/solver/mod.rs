@@ -392,8 +392,20 @@ pub(crate) fn grid_distance(t: f64, h0: f64) -> f64 {
 /// A step not limited by anything but the controller (`free`) may be up to 1e-3 longer
 /// than `h` to land on the grid, as a breakpoint that close counts as reached: after a
 /// landing 1e-9 s before a grid instant the next one is 1.00001 h away, one step, not two.
-pub fn grid_step(t: f64, h: f64, h0: f64, free: bool) -> f64 {
-    let d = grid_distance(t, h0);
+///
+/// `until` is the next instant the run must land on before the grid's (the end, a load's
+/// or a driver's breakpoint; infinity when none): the distance to it is split the same
+/// way. Taking the longest steps toward it and then the grid's split of what is left gave
+/// steps that halved for ever toward the end: 5e-3, 1.25e-3, 1.2e-4, 3.4e-6 s before
+/// `decks/spinning_beam.dat`'s end 4π s with STEP 0.01 s.
+pub fn grid_step(t: f64, h: f64, h0: f64, free: bool, until: f64) -> f64 {
+    let d = grid_distance(t, h0).min(until - t);
+    // A grid instant farther than `h` by round-off only (t is a sum of steps): the step
+    // `h` itself, not one stretched by an ulp at every step (which turned the spinning
+    // beam's exact steady spin, `decks/spinning_beam.dat`, 1e-10 off in 558 steps).
+    if d > h && d - h <= 1e-9 * h {
+        return h;
+    }
     let slack = if free { 1e-3 } else { 1e-9 };
     // n steps of d/n ≤ h (1 + slack).
     let n = (d / h - slack).ceil().max(1.0);
@@ -465,7 +477,7 @@ mod tests {
             let mut t = t0;
             let mut landed = false;
             for _ in 0..200 {
-                let s = grid_step(t, h, h0, false);
+                let s = grid_step(t, h, h0, false, f64::INFINITY);
                 let d = super::grid_distance(t, h0);
                 assert!(
                     s <= h * (1.0 + 1e-9) && s >= (0.5 * h).min(d) * (1.0 - 1e-9),
@@ -480,13 +492,24 @@ mod tests {
             assert!(landed, "t0 = {t0:e}, h = {h:e} never reached the grid");
         }
         // On the grid with the grid's step: exactly h0.
-        assert!((grid_step(5.0 * h0, h0, h0, true) / h0 - 1.0).abs() < 1e-12);
+        assert!((grid_step(5.0 * h0, h0, h0, true, f64::INFINITY) / h0 - 1.0).abs() < 1e-12);
         // 1e-9 s short of a grid instant: one step of 1.00001 h0 when the step is free.
         let t = 5.0 * h0 - 1e-9;
-        assert!((grid_step(t, h0, h0, true) - (h0 + 1e-9)).abs() < 1e-15);
-        assert!((grid_step(t, h0, h0, false) - 0.5 * (h0 + 1e-9)).abs() < 1e-15);
-        let s = grid_step(23.184, 4.983e-5, h0, true);
+        assert!((grid_step(t, h0, h0, true, f64::INFINITY) - (h0 + 1e-9)).abs() < 1e-15);
+        assert!((grid_step(t, h0, h0, false, f64::INFINITY) - 0.5 * (h0 + 1e-9)).abs() < 1e-15);
+        let s = grid_step(23.184, 4.983e-5, h0, true, f64::INFINITY);
         assert!((s - h0 / 3.0).abs() < 1e-12, "{s:e}");
+        // The end (or a breakpoint) before the next grid instant: equal steps to it, no
+        // halving toward it (the spinning beam's end 4π s with STEP 0.01 s).
+        let (mut t, end) = (12.56, 4.0 * std::f64::consts::PI);
+        let mut steps = 0;
+        while t < end - 1e-12 {
+            let s = grid_step(t, (end - t).min(0.01), 0.01, false, end);
+            assert!(s >= 0.5 * (end - t).min(0.01), "step {s:e} at {t}");
+            t += s;
+            steps += 1;
+        }
+        assert_eq!(steps, 1);
     }
 
     /// Whether `h` is a rung `h0 2^(k/4)` (to round-off).
