@@ -279,32 +279,10 @@ pub enum DeckErrorKind {
         reason: crate::model::SplineError,
     },
     /// An EXPR function not shown finite, with the derivatives its use needs, on the
-    /// domain of that use (interval arithmetic: `deck/build/functions.rs`).
-    #[error(
-        "function {id}: `{part}` in `{text}`: its {what} {} at {var} = {at} {unit} ({var} in [{}, {}] {unit} is the domain the run can reach; shown by interval arithmetic, which bounds the expression at every double of it)",
-        if *sure { "is not finite" } else { "could not be shown finite (its enclosure stays unbounded)" },
-        domain.0, domain.1
-    )]
-    FunctionNotFinite {
-        /// The function's number.
-        id: u32,
-        /// The expression.
-        text: String,
-        /// The innermost part whose enclosure blew up.
-        part: String,
-        /// `value`, `first derivative` or `second derivative`.
-        what: String,
-        /// The variable (`t`, `the deflection`).
-        var: String,
-        /// Where, rounded to 9 digits.
-        at: f64,
-        /// The variable's unit.
-        unit: String,
-        /// Whether the `f64` evaluation itself is not finite there.
-        sure: bool,
-        /// The domain checked.
-        domain: (f64, f64),
-    },
+    /// domain of that use (interval arithmetic: `deck/build/functions.rs`). (Boxed: the
+    /// error travels in every `Result` of the parser.)
+    #[error("{0}")]
+    FunctionNotFinite(Box<FunctionNotFinite>),
     /// An expression that does not parse.
     #[error("bad expression `{text}`: expected {expected}, found {found}")]
     BadExpression {
@@ -456,6 +434,55 @@ pub enum DeckErrorKind {
         /// The parameters defined, as a sentence.
         known: String,
     },
+}
+
+/// Where an EXPR function could not be shown finite ([`DeckErrorKind::FunctionNotFinite`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FunctionNotFinite {
+    /// The function's number.
+    pub id: u32,
+    /// The expression.
+    pub text: String,
+    /// The innermost part whose enclosure blew up.
+    pub part: String,
+    /// `value`, `first derivative` or `second derivative`.
+    pub what: &'static str,
+    /// The variable (`t`, `the deflection`).
+    pub var: &'static str,
+    /// Where, rounded to 9 digits.
+    pub at: f64,
+    /// The variable's unit.
+    pub unit: &'static str,
+    /// Whether the `f64` evaluation itself is not finite there.
+    pub sure: bool,
+    /// The domain checked.
+    pub domain: (f64, f64),
+}
+
+impl fmt::Display for FunctionNotFinite {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let FunctionNotFinite {
+            id,
+            text,
+            part,
+            what,
+            var,
+            at,
+            unit,
+            sure,
+            domain,
+        } = self;
+        let how = if *sure {
+            "is not finite"
+        } else {
+            "could not be shown finite (its enclosure stays unbounded)"
+        };
+        write!(
+            f,
+            "function {id}: `{part}` in `{text}`: its {what} {how} at {var} = {at} {unit} ({var} in [{}, {}] {unit} is the domain the run can reach; shown by interval arithmetic, which bounds the expression at every double of it)",
+            domain.0, domain.1
+        )
+    }
 }
 
 /// One mistake in a deck: what, and where (byte span in the source; `None` for file errors).

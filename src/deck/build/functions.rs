@@ -271,17 +271,17 @@ fn not_finite(
     };
     let at = shown(b.point.unwrap_or(0.5 * b.piece.0 + 0.5 * b.piece.1));
     DeckError::new(
-        K::FunctionNotFinite {
+        K::FunctionNotFinite(Box::new(crate::deck::error::FunctionNotFinite {
             id,
             text: e.text.clone(),
             part,
-            what: what.into(),
-            var: var.into(),
+            what,
+            var,
             at,
-            unit: unit.into(),
+            unit,
             sure: b.point.is_some(),
             domain: (shown(domain.0), shown(domain.1)),
-        },
+        })),
         span,
     )
 }

@@ -45,9 +45,9 @@ impl DeckErrorKind {
                 cut(previous);
             }
             K::BadExpression { text, .. } | K::ExpressionTooDeep { text, .. } => cut(text),
-            K::FunctionNotFinite { text, part, .. } => {
-                cut(text);
-                cut(part);
+            K::FunctionNotFinite(f) => {
+                cut(&mut f.text);
+                cut(&mut f.part);
             }
             K::ExpressionNotFinite { text, what } => {
                 cut(text);
