@@ -138,6 +138,69 @@ pub fn conservative(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<RawMode>, 
     Ok(out)
 }
 
+/// The eigenvalues and right eigenvectors of a real matrix, by faer's unblocked Francis
+/// double-shift QR (LAPACK's `dlahqr`, at most 30 iterations per eigenvalue, then an
+/// error): the blocked multishift QR with aggressive early deflation (faer's default above
+/// 75 rows) never returned on the state matrix of `decks/pd_flexible_arm.dat` with a PID
+/// (a swap of its deflation window looping in `lasy2`), and a run's summary hung on it
+/// past SIGTERM. Same factorisation (Hessenberg, Schur, back substitution), O(n³).
+fn eigen_unblocked(a: &Mat<f64>) -> Option<(Vec<faer::c64>, Mat<faer::c64>)> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{ComputeEigenvectors, EvdParams, evd_real, evd_scratch};
+    if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+        return None;
+    }
+    let n = a.nrows();
+    let mut params: faer::Spec<EvdParams, f64> =
+        faer::Spec::new(<EvdParams as faer::Auto<f64>>::auto());
+    params.config.schur.blocking_threshold = usize::MAX;
+    let par = faer::Par::Seq;
+    let mut ur = Mat::<f64>::zeros(n, n);
+    let mut s_re = faer::diag::Diag::<f64>::zeros(n);
+    let mut s_im = faer::diag::Diag::<f64>::zeros(n);
+    let mut buf = MemBuffer::new(evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::Yes,
+        par,
+        params,
+    ));
+    evd_real(
+        a.as_ref(),
+        s_re.as_mut(),
+        s_im.as_mut(),
+        None,
+        Some(ur.as_mut()),
+        par,
+        MemStack::new(&mut buf),
+        params,
+    )
+    .ok()?;
+    // Real eigenvalues: their column; a conjugate pair: columns (re, im) of the first.
+    let (re, im) = (s_re.column_vector(), s_im.column_vector());
+    let mut s = Vec::with_capacity(n);
+    let mut u = Mat::<faer::c64>::zeros(n, n);
+    let mut j = 0;
+    while j < n {
+        if im[j] == 0.0 || j + 1 == n {
+            s.push(faer::c64::new(re[j], 0.0));
+            for i in 0..n {
+                u[(i, j)] = faer::c64::new(ur[(i, j)], 0.0);
+            }
+            j += 1;
+        } else {
+            s.push(faer::c64::new(re[j], im[j]));
+            s.push(faer::c64::new(re[j], -im[j]));
+            for i in 0..n {
+                u[(i, j)] = faer::c64::new(ur[(i, j)], ur[(i, j + 1)]);
+                u[(i, j + 1)] = faer::c64::new(ur[(i, j)], -ur[(i, j + 1)]);
+            }
+            j += 2;
+        }
+    }
+    Some((s, u))
+}
+
 /// The reduced damped or gyroscopic problem's modes (first-order form), one per conjugate
 /// pair (and one per real eigenvalue), sorted by `|s|`.
 pub fn state_space(
@@ -166,9 +229,7 @@ pub fn state_space(
         (false, true) => -mk[(i - n, j)],
         (false, false) => -mc[(i - n, j - n)],
     });
-    let evd = a.eigen().map_err(|_| DenseError::NoConvergence)?;
-    let s: Vec<_> = evd.S().column_vector().iter().copied().collect();
-    let u = evd.U();
+    let (s, u) = eigen_unblocked(&a).ok_or(DenseError::NoConvergence)?;
     let mut out = Vec::new();
     for i in 0..2 * n {
         let z = s[i];
