@@ -221,3 +221,97 @@ fn clearance_impacts_keep_every_planned_row() {
         check_ladder_run(&single, "rows_journal", h, 1.2e-3);
     }
 }
+
+/// `OUTPUT … SUBSTEPS` on the launched bouncing mass (CAME, Kelvin–Voigt k = 1e6 N/m,
+/// c = 200 N·s/m, CLIP OFF, m = 1 kg, v₀ = 1 m/s, IMPACT_STEPS 100) at STEP = 1 ms, about a
+/// third of the 3.16 ms impact: the rows are the grid run's rows, bit for bit, and more, in
+/// strictly increasing time, and every planned instant is still there once. The contact
+/// force's peak read from the sub-step rows matches the closed form's — the force
+/// `k δ + c δ̇` of `δ = (v₀/ω_d) e^{−σt} sin ω_d t`, its maximum over the impact found on a
+/// fine sampling — within the sampling's `max|F̈| Δ²/8` at the largest row spacing Δ during
+/// the contact, plus the trapezoidal rule's (ωΔ)²/4 of the peak (`tests/mechanics/contact.rs`),
+/// plus the touch's landing (1e-4 of a step at v₀: `k v₀ 1e-4 Δ`); the grid rows' peak is
+/// further off than that (the test would tell a run that wrote no sub-step).
+#[test]
+fn substeps_are_a_superset_and_hold_the_contact_peak() {
+    let card = "ANALYSIS DYNAMIC ALPHA 0 STEP 1e-3 END 0.005";
+    let grid = launched_bounce("0.0005", card);
+    let mut sub = grid.clone();
+    sub.output.substeps = true;
+    let (dg, ds) = (run(&grid, "rows_grid"), run(&sub, "rows_sub"));
+    for f in histories(&dg) {
+        let name = f.file_name().unwrap().to_owned();
+        let (hg, rg) = read_csv(&f);
+        let (hs, rs) = read_csv(&ds.join(&name));
+        assert_eq!(hg, hs);
+        let what = format!("SUBSTEPS {}", name.to_string_lossy());
+        let ts: Vec<f64> = rs.iter().map(|r| r[0]).collect();
+        assert_every_row(&ts, 1e-3, 1, 5e-3, true, &what);
+        assert!(rs.len() > rg.len() + 50, "{what}: {} rows only", rs.len());
+        let mut j = 0;
+        for row in &rg {
+            while j < rs.len() && rs[j][0] < row[0] {
+                j += 1;
+            }
+            assert!(
+                j < rs.len() && rs[j] == *row,
+                "{what}: the grid row at t = {} is not among the sub-step rows",
+                row[0]
+            );
+        }
+    }
+    // The closed form.
+    let (k, c, m, v0): (f64, f64, f64, f64) = (1e6, 200.0, 1.0, 1.0);
+    let w = (k / m).sqrt();
+    let sigma = c / (2.0 * m);
+    let wd = (w * w - sigma * sigma).sqrt();
+    let force = |t: f64| {
+        let (s, co, e) = ((wd * t).sin(), (wd * t).cos(), (-sigma * t).exp());
+        k * v0 / wd * e * s + c * v0 * e * (co - sigma / wd * s)
+    };
+    let dur = std::f64::consts::PI / wd;
+    let n = 100_000;
+    let dt = dur / n as f64;
+    let f: Vec<f64> = (0..=n).map(|i| force(i as f64 * dt)).collect();
+    let peak = f.iter().cloned().fold(f64::MIN, f64::max);
+    let f2 = f
+        .windows(3)
+        .map(|w| ((w[2] - 2.0 * w[1] + w[0]) / (dt * dt)).abs())
+        .fold(0.0, f64::max);
+    let column = |dir: &Path| {
+        let (h, rows) = read_csv(&dir.join("element_1.csv"));
+        let i = h
+            .iter()
+            .position(|c| c == "normal_force")
+            .expect("normal_force");
+        let a = h.iter().position(|c| c == "active").expect("active");
+        let contact: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r[a] > 0.5)
+            .map(|r| (r[0], r[i]))
+            .collect();
+        contact
+    };
+    let (cg, cs) = (column(&dg), column(&ds));
+    let max = |c: &[(f64, f64)]| c.iter().map(|x| x.1).fold(f64::MIN, f64::max);
+    let spacing = cs.windows(2).map(|w| w[1].0 - w[0].0).fold(0.0, f64::max);
+    let tol =
+        f2 * spacing * spacing / 8.0 + peak * (w * spacing).powi(2) / 4.0 + k * v0 * 1e-4 * spacing;
+    let (pg, ps) = (max(&cg), max(&cs));
+    println!(
+        "peak force: closed form {peak:.3} N, sub-step rows {ps:.3} N ({} rows in contact, \
+         spacing ≤ {spacing:.2e} s, |err| {:.2e}, tol {tol:.2e}), grid rows {pg:.3} N ({} rows)",
+        cs.len(),
+        (ps - peak).abs(),
+        cg.len()
+    );
+    assert!(ps >= pg, "the sub-step rows' peak is below the grid rows'");
+    assert!(
+        (ps - peak).abs() <= tol,
+        "sub-step peak {ps} vs {peak} (tol {tol})"
+    );
+    assert!(
+        (pg - peak).abs() > tol,
+        "the grid rows alone already hold the peak"
+    );
+}
