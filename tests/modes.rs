@@ -384,15 +384,25 @@ fn analysis_modes_deck_runs_the_modal_analysis() {
     let wall_c = timed(&["modes", d, "--count", "8", "-q", "-o", c]);
     // `cpu_seconds` (issue 34 §8): in the summary of an ANALYSIS MODES deck's run and of
     // `mecano-rs modes`, finite, ≥ 0 and no more than the process's wall time.
-    for (dir, wall) in [(a.clone(), wall_a), (b.clone(), wall_b), (Path::new(c).to_path_buf(), wall_c)] {
+    for (dir, wall) in [
+        (a.clone(), wall_a),
+        (b.clone(), wall_b),
+        (Path::new(c).to_path_buf(), wall_c),
+    ] {
         let s: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
                 .unwrap();
         let cpu = s["cpu_seconds"]
             .as_f64()
             .unwrap_or_else(|| panic!("{}: no cpu_seconds in {s}", dir.display()));
-        eprintln!("{}: cpu_seconds {cpu:.4} (process {wall:.3} s)", dir.display());
-        assert!(cpu.is_finite() && cpu >= 0.0 && cpu <= wall, "{cpu} vs {wall}");
+        eprintln!(
+            "{}: cpu_seconds {cpu:.4} (process {wall:.3} s)",
+            dir.display()
+        );
+        assert!(
+            cpu.is_finite() && cpu >= 0.0 && cpu <= wall,
+            "{cpu} vs {wall}"
+        );
     }
     let read = |dir: &Path| std::fs::read_to_string(dir.join("modes.csv")).unwrap();
     let reference = read(Path::new(c));
