@@ -137,6 +137,10 @@ impl ConstraintVelocity {
     }
 }
 
+/// A constrained element's constraint entries: `(local row, local column, position in the
+/// matrix)`.
+type Entries = Vec<(usize, usize, usize)>;
+
 /// The index-1 solve's own matrix and work vectors (sized once).
 pub(super) struct Index1 {
     /// `[c_a M  sBᵀ; sB  0]`, the iteration matrix's pattern.
@@ -156,7 +160,7 @@ pub(super) struct Index1 {
     mass: Vec<f64>,
     /// The constrained elements, each with a local buffer and the positions of its
     /// constraint entries `(local row, local column, position in the matrix)`.
-    constrained: Vec<(usize, Local, Vec<(usize, usize, usize)>)>,
+    constrained: Vec<(usize, Local, Entries)>,
     /// The stage scheme's accelerations and multipliers of the state, while the index-1
     /// ones stand in their place (`swapped`).
     acc: Vec<[Vector3<f64>; 2]>,
