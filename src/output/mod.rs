@@ -26,6 +26,7 @@ pub mod netcdf;
 mod plan;
 pub mod read;
 mod record;
+mod sampling;
 mod stream;
 pub mod vtk;
 
@@ -37,6 +38,7 @@ use netcdf::Columnar;
 pub use plan::{CSV_NUMBER_BYTES, Volume, volume};
 use plan::{groups, plan};
 pub use record::{Recorded, Recorder};
+pub use sampling::Sampling;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -50,95 +52,6 @@ pub const ENERGY_HEADER: &str = "t,kinetic,strain,gravity,total,external_work,da
 
 /// A progress callback: time reached, end time, counters.
 pub type ProgressFn = Box<dyn FnMut(f64, f64, &Stats)>;
-
-/// Which accepted states `OUTPUT … EVERY n` writes: with fixed steps, the states at the
-/// instants `k n h` (steps land back on that grid after contact events, which add steps of
-/// their own, so a history keeps regular instants); with adaptive steps, every n-th state.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Sampling {
-    every: u64,
-    /// `n h` for fixed steps.
-    period: Option<f64>,
-    /// `OUTPUT … SUBSTEPS`: also the states of steps shorter than `step` (fixed steps), or
-    /// every accepted state (adaptive).
-    #[serde(default)]
-    substeps: bool,
-    /// The deck's STEP, s (fixed steps; 0 otherwise).
-    #[serde(default)]
-    step: f64,
-    /// The end time, s: an instant less than r before it, or after it, is the end's row.
-    #[serde(default = "no_end")]
-    end: f64,
-}
-
-/// A checkpoint's sampling that predates `end`: no limit.
-fn no_end() -> f64 {
-    f64::INFINITY
-}
-
-impl Sampling {
-    /// The sampling a model asks for.
-    pub fn of(model: &crate::model::Model) -> Self {
-        let every = u64::from(model.output.every.max(1));
-        let (period, step, end) = match &model.analysis {
-            crate::model::Analysis::Dynamic {
-                step,
-                adaptive,
-                end,
-                ..
-            } if adaptive.is_none() => (Some(*step * every as f64), *step, *end),
-            _ => (None, 0.0, f64::INFINITY),
-        };
-        Sampling {
-            every,
-            period,
-            substeps: model.output.substeps,
-            step,
-            end,
-        }
-    }
-
-    /// Every accepted state.
-    pub fn every_step() -> Self {
-        Sampling {
-            every: 1,
-            period: None,
-            substeps: false,
-            step: 0.0,
-            end: f64::INFINITY,
-        }
-    }
-
-    /// Whether the state at `t`, reached by a step `h`, is the first to reach an instant
-    /// `k p` (k ≥ 1) of the output grid: the step `(t − h, t]` crosses `k p − r`, r the
-    /// stepper's reach [`crate::solver::GRID_REACH`]·STEP. The stepper lands on every
-    /// instant or, when an event landed it less than r before one, steps over it (no
-    /// sliver step is taken): that state is then the instant's row. The steps' intervals
-    /// are disjoint, so each instant has exactly one row (issue 34 §7: a touch landed
-    /// 1e-4 STEP before an instant, with MINSTEP 3e-4 STEP, lost that instant's row when a
-    /// row had to be within 1e-6 of it).
-    fn first_at_instant(&self, t: f64, h: f64, p: f64) -> bool {
-        // STEP = p / every (a checkpoint of an older version has no `step`).
-        let r = crate::solver::GRID_REACH * p / self.every as f64;
-        let k = ((t + r) / p).floor();
-        // An instant less than r before the end (or after it) has the end's state, which
-        // is always written.
-        let at_end = t >= self.end - 1e-9 * p / self.every as f64;
-        k >= 1.0 && t - h < k * p - r && (k * p <= self.end - r || at_end)
-    }
-
-    /// Whether the state of a snapshot is written.
-    pub fn takes(&self, snap: &Snapshot) -> bool {
-        match self.period {
-            Some(p) => {
-                snap.step == 0
-                    || self.first_at_instant(snap.integ.t, snap.h, p)
-                    || (self.substeps && snap.h < self.step * (1.0 - 1e-9))
-            }
-            None => self.substeps || snap.step.is_multiple_of(self.every),
-        }
-    }
-}
 
 /// Streams a run's histories to a directory.
 pub struct Writer {
