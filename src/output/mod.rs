@@ -214,7 +214,7 @@ impl Writer {
         };
         w.last_row = state.last_row;
         if let Some(sampling) = state.sampling {
-            w.sampling = sampling;
+            w.sampling = sampling.resumed(&w.sampling);
         }
         Ok(w)
     }

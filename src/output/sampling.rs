@@ -19,11 +19,14 @@ pub struct Sampling {
     #[serde(default)]
     step: f64,
     /// The end time, s: an instant less than r before it, or after it, is the end's row.
-    #[serde(default = "no_end")]
+    /// Not in checkpoints (their postcard layout is positional: a field added here would
+    /// misread every earlier checkpoint's next fields); a resumed Writer takes it from the
+    /// model ([`Sampling::resumed`]).
+    #[serde(skip, default = "no_end")]
     end: f64,
 }
 
-/// A checkpoint's sampling that predates `end`: no limit.
+/// No end time (a sampling read from a checkpoint, before [`Sampling::resumed`]).
 fn no_end() -> f64 {
     f64::INFINITY
 }
@@ -47,6 +50,15 @@ impl Sampling {
             substeps: model.output.substeps,
             step,
             end,
+        }
+    }
+
+    /// A checkpoint's sampling with the end time of the model it resumes (`fresh`, as
+    /// [`Sampling::of`] makes it).
+    pub fn resumed(self, fresh: &Sampling) -> Self {
+        Sampling {
+            end: fresh.end,
+            ..self
         }
     }
 
