@@ -39,7 +39,7 @@ mod trajectory;
 pub use animate::{animate, connectivity, deck_of, refine_of};
 pub use history::history;
 pub use modes::{ModesArgs, label as modes_label, modes};
-pub use table::{Table, quantity, read_node};
+pub use table::{Table, quantity, read_element, read_node};
 pub use trajectory::trajectory;
 
 /// `mecano-rs plot …`: the figure to draw.
@@ -108,18 +108,27 @@ pub struct TrajectoryArgs {
     pub common: Common,
 }
 
-/// `mecano-rs plot history OUT_DIR... --node 23 --columns rx,vy,ay -o fig.svg`
+/// `mecano-rs plot history OUT_DIR... --node 23 --columns rx,vy,ay -o fig.svg`, or an
+/// element's columns: `--element 23 --element-columns normal_force`.
 #[derive(Args, Debug, Clone)]
 pub struct HistoryArgs {
     /// Output directories of runs (several: overlaid).
     #[arg(required = true, value_name = "OUT_DIR")]
     pub runs: Vec<PathBuf>,
     /// Nodes (the deck's numbers); one panel per node and column.
-    #[arg(long = "node", alias = "nodes", num_args = 1.., required = true, value_name = "N")]
+    #[arg(long = "node", alias = "nodes", num_args = 1.., required_unless_present = "elements", value_name = "N")]
     pub nodes: Vec<u32>,
     /// Columns of node_<N>.csv, comma separated (x y z ux uy uz rx ry rz vx vy vz wx wy wz ax ay az).
-    #[arg(long, value_delimiter = ',', required = true, value_name = "COLUMNS")]
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
     pub columns: Vec<String>,
+    /// Elements (the deck's numbers) whose element_<N>.csv columns are drawn, one panel per
+    /// element and column: a driving torque, a contact force, a spring's tension.
+    #[arg(long = "element", alias = "elements", num_args = 1.., value_name = "N")]
+    pub elements: Vec<u32>,
+    /// Columns of element_<N>.csv, comma separated (the element's header, README: e.g.
+    /// normal_force, torque, force); default: --columns.
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    pub element_columns: Vec<String>,
     /// Output file, labels, time window, size, title.
     #[command(flatten)]
     pub common: Common,

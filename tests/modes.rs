@@ -371,11 +371,39 @@ fn analysis_modes_deck_runs_the_modal_analysis() {
             String::from_utf8_lossy(&o.stderr)
         );
     };
-    ok(mecano(&[p, "-q", "-o", a.to_str().unwrap()]));
-    ok(mecano(&["modes", p, "-q", "-o", b.to_str().unwrap()]));
+    // Each run's wall time, which bounds the seconds its summary.json states.
+    let timed = |args: &[&str]| {
+        let t0 = std::time::Instant::now();
+        ok(mecano(args));
+        t0.elapsed().as_secs_f64()
+    };
+    let wall_a = timed(&[p, "-q", "-o", a.to_str().unwrap()]);
+    let wall_b = timed(&["modes", p, "-q", "-o", b.to_str().unwrap()]);
     let d = deck("cantilever_modes.dat");
     let (d, c) = (d.to_str().unwrap(), c.to_str().unwrap());
-    ok(mecano(&["modes", d, "--count", "8", "-q", "-o", c]));
+    let wall_c = timed(&["modes", d, "--count", "8", "-q", "-o", c]);
+    // `cpu_seconds` (issue 34 §8): in the summary of an ANALYSIS MODES deck's run and of
+    // `mecano-rs modes`, finite, ≥ 0 and no more than the process's wall time.
+    for (dir, wall) in [
+        (a.clone(), wall_a),
+        (b.clone(), wall_b),
+        (Path::new(c).to_path_buf(), wall_c),
+    ] {
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+                .unwrap();
+        let cpu = s["cpu_seconds"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{}: no cpu_seconds in {s}", dir.display()));
+        eprintln!(
+            "{}: cpu_seconds {cpu:.4} (process {wall:.3} s)",
+            dir.display()
+        );
+        assert!(
+            cpu.is_finite() && cpu >= 0.0 && cpu <= wall,
+            "{cpu} vs {wall}"
+        );
+    }
     let read = |dir: &Path| std::fs::read_to_string(dir.join("modes.csv")).unwrap();
     let reference = read(Path::new(c));
     assert_eq!(reference.lines().count(), 1 + 8);
@@ -906,4 +934,29 @@ fn check_compares_three_integrators_and_sparse_does_not_invent_the_highest() {
     assert!(!text.lines().any(|l| l.ends_with("highest")), "{text}");
     assert!(text.contains("highest frequency not computed"), "{text}");
     let _ = std::fs::remove_dir_all(&base);
+}
+
+/// A spherical pendulum hanging at rest (decks/spherical_pendulum_modes.dat: 1 kg on a rigid
+/// 1 m link, rotary inertia I = 1e-3 kg·m² about each axis, SPHERICAL at the pivot): two
+/// swings at `ω² = m g L/(m L² + I)` (the link turns with the mass: its rotary inertia adds
+/// to `m L²`), f = 0.49824 Hz, and the spin about the vertical link, which nothing resists:
+/// a zero, "rigid". It was listed as an elastic (or, negative, "unstable") mode of
+/// ω² = 1.9e-13 1/s²: round-off of a stiffness of norm ~10 N·m seen through the spin's mass
+/// I = 1e-3 (src/modes/mod.rs, the per-mode zero threshold). The swings to the Rayleigh
+/// quotient's round-off (1e-9 relative asserted, as the simple pendulum's).
+#[test]
+fn spherical_pendulum_spin_is_rigid_and_its_swings_match_the_closed_form() {
+    let model = load(&deck("spherical_pendulum_modes.dat"), &[], 1, None).unwrap();
+    let a = modes(&model, About::Initial, 3);
+    let z: Vec<(ModeKind, f64)> = a.modes.iter().map(|m| (m.kind, m.natural_hz)).collect();
+    let exact = (9.81f64 / (1.0 + 1e-3)).sqrt() / (2.0 * PI);
+    eprintln!("spherical pendulum: {z:?} (swing exact {exact} Hz)");
+    assert_eq!(a.modes.len(), 3);
+    assert_eq!(a.rigid_modes, 1, "{z:?}");
+    assert_eq!(a.modes[0].kind, ModeKind::Rigid, "{z:?}");
+    assert_eq!(a.modes[0].natural_hz, 0.0, "{z:?}");
+    for m in &a.modes[1..] {
+        assert_eq!(m.kind, ModeKind::Elastic, "{z:?}");
+        assert!((m.natural_hz - exact).abs() <= 1e-9 * exact, "{z:?}");
+    }
 }

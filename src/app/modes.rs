@@ -411,6 +411,9 @@ fn analyse_and_write(
     solver: Solver,
 ) -> u8 {
     let deck = source.deck;
+    // The analysis's seconds for summary.json's `cpu_seconds`, measured as a dynamic run's
+    // (`solver::Stats::cpu_seconds`: elapsed time on the one thread that computes).
+    let start = std::time::Instant::now();
     if about == About::Rotating
         && let Err(e) = Frame::from_model(model, 0.0)
     {
@@ -458,6 +461,7 @@ fn analyse_and_write(
     let step = deck_step(model);
     let mut summary = output::summary(&a, &deck.display().to_string(), &state, integ.t, step);
     summary["vtk"] = modes_vtk::summary(&integ.sys, &a);
+    summary["cpu_seconds"] = serde_json::json!(start.elapsed().as_secs_f64());
     if let Some(w) = not_equilibrium {
         summary["warnings"] = serde_json::json!([w]);
     }

@@ -408,7 +408,25 @@ fn solve_dense(
     // model without stiffness): the floor `1e-8` below.
     let stiffness_scale = model_scale(&lin.k, &lin.m).max(w2max).max(1e-8);
     let zero = dense::ZERO_FACTOR * f64::EPSILON * stiffness_scale;
-    let is_zero = |r: &dense::RawMode| r.omega2.abs() <= zero;
+    // Per mode, the same round-off seen through the mode's own mass: a perturbation δK of
+    // the reduced stiffness moves ω² by the Rayleigh quotient `φᵀδKφ / φᵀMφ`, at most
+    // `ε‖K‖ · |φ|²/φᵀMφ`, and `|φ|²/φᵀMφ` is 1/(the smallest mass) for a mode that moves
+    // only a light direction: a spherical pendulum's spin about its link carries the point
+    // mass's rotary inertia (1e-3 kg·m²) alone, and its ω² = 1.9e-13 1/s² of round-off, above
+    // ε‖K‖/‖M‖ (‖M‖ the 1 kg mass), was called a frequency — or, negative, an instability
+    // (issue 34 §8). ‖K‖ the max-abs norm of the reduced stiffness.
+    let k_norm = max_abs(&kr);
+    let mode_zero = |r: &dense::RawMode| {
+        let mass = r.shape.dot(&(&mr * &r.shape));
+        let norm2 = r.shape.norm_squared();
+        let own = if mass > 0.0 && norm2 > 0.0 {
+            dense::ZERO_FACTOR * f64::EPSILON * k_norm * norm2 / mass
+        } else {
+            0.0
+        };
+        zero.max(own)
+    };
+    let is_zero = |r: &dense::RawMode| r.omega2.abs() <= mode_zero(r);
     let rigid_modes = raw.iter().filter(|r| is_zero(r)).count();
     let w2max_finite = raw
         .iter()

@@ -26,6 +26,7 @@ pub mod netcdf;
 mod plan;
 pub mod read;
 mod record;
+mod sampling;
 mod stream;
 pub mod vtk;
 
@@ -37,6 +38,7 @@ use netcdf::Columnar;
 pub use plan::{CSV_NUMBER_BYTES, Volume, volume};
 use plan::{groups, plan};
 pub use record::{Recorded, Recorder};
+pub use sampling::Sampling;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -50,65 +52,6 @@ pub const ENERGY_HEADER: &str = "t,kinetic,strain,gravity,total,external_work,da
 
 /// A progress callback: time reached, end time, counters.
 pub type ProgressFn = Box<dyn FnMut(f64, f64, &Stats)>;
-
-/// Which accepted states `OUTPUT … EVERY n` writes: with fixed steps, the states at the
-/// instants `k n h` (steps land back on that grid after contact events, which add steps of
-/// their own, so a history keeps regular instants); with adaptive steps, every n-th state.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Sampling {
-    every: u64,
-    /// `n h` for fixed steps.
-    period: Option<f64>,
-    /// `OUTPUT … SUBSTEPS`: also the states of steps shorter than `step` (fixed steps), or
-    /// every accepted state (adaptive).
-    #[serde(default)]
-    substeps: bool,
-    /// The deck's STEP, s (fixed steps; 0 otherwise).
-    #[serde(default)]
-    step: f64,
-}
-
-impl Sampling {
-    /// The sampling a model asks for.
-    pub fn of(model: &crate::model::Model) -> Self {
-        let every = u64::from(model.output.every.max(1));
-        let (period, step) = match &model.analysis {
-            crate::model::Analysis::Dynamic { step, adaptive, .. } if adaptive.is_none() => {
-                (Some(*step * every as f64), *step)
-            }
-            _ => (None, 0.0),
-        };
-        Sampling {
-            every,
-            period,
-            substeps: model.output.substeps,
-            step,
-        }
-    }
-
-    /// Every accepted state.
-    pub fn every_step() -> Self {
-        Sampling {
-            every: 1,
-            period: None,
-            substeps: false,
-            step: 0.0,
-        }
-    }
-
-    /// Whether the state of a snapshot is written.
-    pub fn takes(&self, snap: &Snapshot) -> bool {
-        match self.period {
-            Some(p) => {
-                let t = snap.integ.t;
-                snap.step == 0
-                    || (t / p - (t / p).round()).abs() <= 1e-6
-                    || (self.substeps && snap.h < self.step * (1.0 - 1e-9))
-            }
-            None => self.substeps || snap.step.is_multiple_of(self.every),
-        }
-    }
-}
 
 /// Streams a run's histories to a directory.
 pub struct Writer {
@@ -271,7 +214,7 @@ impl Writer {
         };
         w.last_row = state.last_row;
         if let Some(sampling) = state.sampling {
-            w.sampling = sampling;
+            w.sampling = sampling.resumed(&w.sampling);
         }
         Ok(w)
     }

@@ -1,7 +1,7 @@
-//! `plot history`: columns of node histories against time, runs overlaid.
+//! `plot history`: columns of node and element histories against time, runs overlaid.
 
 use super::draw::*;
-use super::table::axis_label;
+use super::table::{axis_label, read_element};
 use super::*;
 
 /// `plot history`: returns the written file.
@@ -9,30 +9,51 @@ pub fn history(a: &HistoryArgs) -> Result<PathBuf, PlotError> {
     let c = &a.common;
     let fmt = format_of(&c.out, &["svg", "png"])?;
     let labels = labels_for(&a.runs, &c.labels)?;
-    let columns: Vec<String> = a
-        .columns
-        .iter()
-        .map(|s| s.trim().to_string())
-        .filter(|s| !s.is_empty())
-        .collect();
-    if columns.is_empty() {
+    let list = |cols: &[String]| -> Vec<String> {
+        cols.iter()
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+            .collect()
+    };
+    let columns = list(&a.columns);
+    let element_columns = if a.element_columns.is_empty() {
+        columns.clone()
+    } else {
+        list(&a.element_columns)
+    };
+    if !a.nodes.is_empty() && columns.is_empty() {
         return Err(PlotError::Usage("--columns: no column given".into()));
     }
-    // panels[(node, column)] = one series per run
-    let mut panels: Vec<(String, String, Vec<Series>)> = Vec::new();
-    let mut tables: Vec<BTreeMap<u32, Table>> = Vec::new();
-    for run in &a.runs {
-        let mut m = BTreeMap::new();
-        for &n in &a.nodes {
-            m.insert(n, read_node(run, n)?);
-        }
-        tables.push(m);
+    if !a.elements.is_empty() && element_columns.is_empty() {
+        return Err(PlotError::Usage(
+            "--element-columns (or --columns): no column given".into(),
+        ));
     }
+    // What is drawn: (caption, one table per run, its columns), nodes then elements.
+    let mut sources: Vec<(String, Vec<Table>, &[String])> = Vec::new();
     for &n in &a.nodes {
-        for col in &columns {
+        let tables = a
+            .runs
+            .iter()
+            .map(|r| read_node(r, n))
+            .collect::<Result<_, _>>()?;
+        sources.push((format!("node {n}"), tables, &columns));
+    }
+    for &e in &a.elements {
+        let tables = a
+            .runs
+            .iter()
+            .map(|r| read_element(r, e))
+            .collect::<Result<_, _>>()?;
+        sources.push((format!("element {e}"), tables, &element_columns));
+    }
+    // panels[(source, column)] = one series per run
+    let mut panels: Vec<(String, String, Vec<Series>)> = Vec::new();
+    for (caption, tables, cols) in &sources {
+        for col in cols.iter() {
             let mut ss = Vec::new();
             for (ri, label) in labels.iter().enumerate() {
-                let table = &tables[ri][&n];
+                let table = &tables[ri];
                 let t = table.column("t")?;
                 let y = table.column(col)?;
                 ss.push(Series {
@@ -44,7 +65,7 @@ pub fn history(a: &HistoryArgs) -> Result<PathBuf, PlotError> {
                         .collect(),
                 });
             }
-            panels.push((format!("node {n}"), axis_label(col), ss));
+            panels.push((caption.clone(), axis_label(col), ss));
         }
     }
     let title = c.title.clone().unwrap_or_else(|| {

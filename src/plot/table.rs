@@ -56,6 +56,23 @@ impl Table {
     }
 }
 
+/// Reads `element_<N>.csv` of an output directory.
+pub fn read_element(dir: &Path, element: u32) -> Result<Table, PlotError> {
+    if !dir.is_dir() {
+        return Err(PlotError::NoDir(dir.to_path_buf()));
+    }
+    let file = dir.join(format!("element_{element}.csv"));
+    if !file.is_file() && !crate::output::columnar::holds(&file) {
+        return Err(PlotError::NoFile {
+            file,
+            hint: format!(
+                "element {element} was not written by this run: list it in the deck's OUTPUT ELEMENTS"
+            ),
+        });
+    }
+    Table::read(&file)
+}
+
 /// Reads `node_<N>.csv` of an output directory.
 pub fn read_node(dir: &Path, node: u32) -> Result<Table, PlotError> {
     if !dir.is_dir() {

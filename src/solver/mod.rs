@@ -363,8 +363,16 @@ pub fn ladder_step(h: f64, proposal: f64, h0: f64) -> f64 {
     }
 }
 
+/// How close before an instant `k h₀` of a fixed-step run's grid a state counts as having
+/// reached it, in units of h₀: no step shorter than this is taken to land on the grid (a
+/// sliver's 1/(βh²) would swamp the iteration matrix, issue 35), so a state an event landed
+/// that close before the instant stands for it — in the steps ([`grid_distance`]) and in the
+/// histories (`output::Sampling`, which writes it as that instant's row: issue 34 §7).
+pub const GRID_REACH: f64 = 1e-3;
+
 /// The distance from `t` to the next instant `k h₀` of a fixed-step run's grid (one closer
-/// than 1e-3 h₀ counts as reached: t is a sum of steps, on the grid within round-off).
+/// than [`GRID_REACH`] h₀ counts as reached: t is a sum of steps, on the grid within
+/// round-off, or an event landed it there).
 pub(crate) fn grid_distance(t: f64, h0: f64) -> f64 {
     let k = (t / h0).round();
     let next = if (t - k * h0).abs() <= 1e-6 * h0 {
@@ -373,7 +381,7 @@ pub(crate) fn grid_distance(t: f64, h0: f64) -> f64 {
         (t / h0).ceil() * h0
     };
     let d = next - t;
-    if d < 1e-3 * h0 { d + h0 } else { d }
+    if d < GRID_REACH * h0 { d + h0 } else { d }
 }
 
 /// The step from `t` toward the grid `k h₀` of a fixed-step run, given the step `h` the

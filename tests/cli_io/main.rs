@@ -8,6 +8,7 @@ mod common;
 mod cli;
 mod compare;
 mod energy_guard_run;
+mod every_row;
 mod large;
 mod modes_output;
 mod outdir;

@@ -164,3 +164,126 @@ fn running_a_deck_still_works_without_subcommand() {
         .unwrap();
     assert!(o.status.success());
 }
+
+/// The points of each `<polyline>` of an SVG, as (x, y) pixels.
+fn polylines(svg: &str) -> Vec<Vec<(f64, f64)>> {
+    svg.split("<polyline")
+        .skip(1)
+        .filter_map(|p| {
+            let i = p.find("points=\"")? + 8;
+            let j = p[i..].find('"')?;
+            Some(
+                p[i..i + j]
+                    .split_whitespace()
+                    .filter_map(|xy| {
+                        let (x, y) = xy.split_once(',')?;
+                        Some((x.parse().ok()?, y.parse().ok()?))
+                    })
+                    .collect(),
+            )
+        })
+        .collect()
+}
+
+/// `plot history --element` (issue 34 §8): an element's columns drawn against time — the
+/// clearance joint's normal force in decks/clearance_impact.dat, beside the journal's
+/// velocity (node 2): two panels, each holding one series of as many points as the file
+/// has rows, the force's not flat (the impact); an element not written and a column the
+/// element does not have are located errors (exit 2).
+#[test]
+fn history_draws_an_elements_columns() {
+    let dir = scratch("element");
+    let out = dir.join("out");
+    let st = Command::new(BIN)
+        .arg(common::deck_path("clearance_impact.dat"))
+        .arg("-o")
+        .arg(&out)
+        .arg("--quiet")
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let o = out.to_str().unwrap();
+    let rows = std::fs::read_to_string(out.join("element_1.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    let svg_path = dir.join("h.svg");
+    let (code, err) = plot(&[
+        "history",
+        o,
+        "--node",
+        "2",
+        "--columns",
+        "vx",
+        "--element",
+        "1",
+        "--element-columns",
+        "normal_force",
+        "-o",
+        svg_path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    assert!(svg.contains("element 1") && svg.contains("normal_force") && svg.contains("node 2"));
+    let series: Vec<_> = polylines(&svg)
+        .into_iter()
+        .filter(|p| p.len() == rows)
+        .collect();
+    assert_eq!(
+        series.len(),
+        2,
+        "{rows} rows: no two series of that many points"
+    );
+    let (lo, hi) = series[1]
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    assert!(hi - lo > 10.0, "the force's series is flat: {lo}..{hi} px");
+    // The element's columns alone (--columns serves when --element-columns is not given).
+    let png = dir.join("f.png");
+    let (code, err) = plot(&[
+        "history",
+        o,
+        "--element",
+        "1",
+        "--columns",
+        "normal_force,penetration",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    // Errors.
+    let x = dir.join("x.svg");
+    let x = x.to_str().unwrap();
+    let (code, err) = plot(&[
+        "history",
+        o,
+        "--element",
+        "7",
+        "--columns",
+        "normal_force",
+        "-o",
+        x,
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("element_7.csv") && err.contains("OUTPUT ELEMENTS"),
+        "{err}"
+    );
+    let (code, err) = plot(&[
+        "history",
+        o,
+        "--element",
+        "1",
+        "--columns",
+        "torque",
+        "-o",
+        x,
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("no column \"torque\"") && err.contains("normal_force"),
+        "{err}"
+    );
+}
