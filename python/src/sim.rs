@@ -130,7 +130,7 @@ impl Inner {
             let mut integ = solver::prepare(&self.model)
                 .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.deck.name)))?;
             integ.abort = Some(abort.clone());
-            let mut rec = memory::recorder(&self.model, &self.deck.name, self.deck.refine, &integ);
+            let mut rec = recorder(self, &integ);
             let none = mecano::interrupt::Interrupts::none();
             let stepper = Stepper::start(
                 &self.model,
@@ -797,7 +797,7 @@ impl Simulation {
                 "{e} (a simulation saved with inputs is restored by one with the same inputs: add them, then sim.restore(dir))"
             ))
         })?;
-        let mut rec = memory::recorder(&inner.model, &inner.deck.name, inner.deck.refine, &integ);
+        let mut rec = recorder(&inner, &integ);
         let none = mecano::interrupt::Interrupts::none();
         let stepper = Stepper::start(
             &inner.model,
@@ -816,6 +816,27 @@ impl Simulation {
         });
         Ok(())
     }
+}
+
+/// The recorder of a Simulation's histories. With inputs, the summary's
+/// `step_resolution` block (modes about the initial state, `modes::run_summary`) is not
+/// computed: it would call the Python laws with the GIL held, and on
+/// decks/pd_flexible_arm.dat with a PD law the dense eigensolver of that block does not
+/// return (faer's real Schur; the CLI hangs the same way with a deck PID on that arm).
+fn recorder(inner: &Inner, integ: &Integrator) -> Recorder {
+    if inner.inputs.is_empty() {
+        return memory::recorder(&inner.model, &inner.deck.name, inner.deck.refine, integ);
+    }
+    let mut rec = Recorder::new(&inner.deck.name, &inner.model, &integ.sys);
+    rec.refine = inner.deck.refine.max(1);
+    rec.notes.insert(
+        mecano::modes::run_summary::KEY.into(),
+        serde_json::json!({
+            "computed": false,
+            "reason": "not computed: a Simulation with inputs (use mecano.modes on the deck)",
+        }),
+    );
+    rec
 }
 
 /// The simulation's state, started.

@@ -287,3 +287,26 @@ def test_bad_arguments_raise_python_exceptions(root, call, error):
     sim = mecano.Simulation(arm(root, 1e-3))
     with pytest.raises(error):
         call(sim)
+
+
+def test_pd_law_on_the_flexible_arm_starts_and_steps(root):
+    """examples/python/pd_flexible_arm.py's set-up: starting it used to hang in the
+    run summary's modal block (a dense eigensolve that did not return, with the GIL
+    held). Run in a child process so that a regression fails instead of hanging."""
+    import subprocess
+    import sys
+
+    code = f"""
+import math, mecano
+sim = mecano.Simulation(mecano.Deck.read({str(root / 'decks' / 'pd_flexible_arm.dat')!r}))
+sim.add_input(hinge=1, law=lambda t, s: 20.0 * (0.1 - s.joint_angle(1)) - 2.0 * s.joint_rate(1),
+              sensors=[("angle", 1), ("rate", 1)])
+sim.advance(0.05)
+run = sim.run()
+assert run.summary["step_resolution"]["computed"] is False
+print(sim.t, sim.joint_angle(1))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    t, angle = map(float, out.stdout.split())
+    assert t == pytest.approx(0.05) and 0 < angle < 0.1
