@@ -228,6 +228,7 @@ impl Simulation {
                 .collect();
             (laws, inner.run.as_ref().map_or(0.0, |r| r.integ.t))
         };
+        let mut changed = false;
         for (id, f, held) in laws {
             this.in_law.store(true, Ordering::SeqCst);
             let r = f.call1(slf.py(), (t, slf));
@@ -257,7 +258,23 @@ impl Simulation {
                     "the law of input {id} returned {v} at t = {t} s"
                 ))));
             }
+            changed |= held.get() != v;
             held.set(v);
+        }
+        // Before the first step the initial accelerations were computed with the inputs'
+        // `value`: recomputed with the laws' values at t = 0, so the first step starts
+        // from the equations of motion it integrates (the arm held at rest by its law
+        // stays at rest). The t = 0 row already recorded keeps the former accelerations.
+        if changed {
+            let mut inner = this.lock()?;
+            if let Some(r) = inner.run.as_mut()
+                && r.integ.stats.steps == 0
+                && r.integ.t == 0.0
+            {
+                r.integ
+                    .consistent_accelerations()
+                    .map_err(|f| MecanoError::new_err(f.to_string()))?;
+            }
         }
         Ok(())
     }

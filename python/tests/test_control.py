@@ -310,3 +310,13 @@ print(sim.t, sim.joint_angle(1))
     assert out.returncode == 0, out.stderr
     t, angle = map(float, out.stdout.split())
     assert t == pytest.approx(0.05) and 0 < angle < 0.1
+
+
+def test_an_explicit_law_sets_the_initial_accelerations(root):
+    """The explicit law's value at t = 0 (not the input's default `value` = 0) is what the
+    start's accelerations balance: a law that holds the arm up against gravity (9.81 N m)
+    keeps it at rest from the first step, as the held input does."""
+    sim = mecano.Simulation(arm(root, 1e-3))
+    sim.add_input(hinge=1, law=lambda t, sim: 9.81, tangent="explicit")
+    sim.advance(0.1)
+    assert abs(sim.joint_angle(1)) < 1e-12
