@@ -4,10 +4,14 @@
 //! calls (one per sensor, only when the iteration matrix is rebuilt). An exception, a
 //! non-number or a non-finite value stops the run: the error is kept for Python and the
 //! integrator's abort flag set, so that the step is given up at its next iteration.
+//! A KeyboardInterrupt (Ctrl-C while the law's Python code runs) is not the law's
+//! failure: it is kept in [`PyLaw::interrupt`], the law called again for the value the
+//! step needs, and the Simulation stops at the end of that step (issue 36 §7); a second
+//! Ctrl-C during that call gives the step up as a failure would.
 
 use crate::poll::Pending;
 use mecano::model::control::{Law, Sensor};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -130,6 +134,9 @@ pub struct PyLaw {
     pub pending: Pending,
     /// Set when it fails: the step under way is given up.
     pub abort: Arc<AtomicBool>,
+    /// Where a KeyboardInterrupt raised in the law goes (the run stops at the end of
+    /// the step: [`crate::poll::interrupts`] reads it between steps).
+    pub interrupt: Pending,
 }
 
 impl PyLaw {
@@ -159,6 +166,22 @@ impl PyLaw {
         Ok(v)
     }
 
+    /// [`PyLaw::call`], a KeyboardInterrupt kept aside and the call made once more.
+    fn call_through_ctrl_c(&self, py: Python<'_>, t: f64, s: &[f64]) -> PyResult<f64> {
+        match self.call(py, t, s) {
+            Err(e) if e.is_instance_of::<PyKeyboardInterrupt>(py) => {
+                let mut slot = self.interrupt.lock().unwrap_or_else(|e| e.into_inner());
+                if slot.is_none() {
+                    *slot = Some(e);
+                    drop(slot);
+                    return self.call(py, t, s);
+                }
+                Err(e)
+            }
+            r => r,
+        }
+    }
+
     fn fail(&self, e: PyErr) -> f64 {
         let mut slot = self.pending.lock().unwrap_or_else(|e| e.into_inner());
         if slot.is_none() {
@@ -175,7 +198,7 @@ impl Law for PyLaw {
             return f64::NAN;
         }
         Python::attach(|py| {
-            let u = match self.call(py, t, s) {
+            let u = match self.call_through_ctrl_c(py, t, s) {
                 Ok(u) => u,
                 Err(e) => return self.fail(e),
             };
@@ -186,7 +209,7 @@ impl Law for PyLaw {
                 for i in 0..s.len() {
                     let d = 1e-7 * s[i].abs().max(1.0);
                     p[i] = s[i] + d;
-                    match self.call(py, t, &p) {
+                    match self.call_through_ctrl_c(py, t, &p) {
                         Ok(v) => g[i] = (v - u) / d,
                         Err(e) => return self.fail(e),
                     }

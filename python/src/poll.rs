@@ -17,14 +17,33 @@ pub const POLL: Duration = Duration::from_millis(50);
 pub type Pending = Arc<Mutex<Option<PyErr>>>;
 
 /// Flags the run reads, with the hook that polls Python (see the module docs), and the
-/// slot of the error that stopped it.
-pub fn interrupts(progress: Option<Py<PyAny>>, end: f64) -> (Interrupts, Pending) {
+/// slot of the error that stopped it. `kept`: where a law keeps a KeyboardInterrupt it
+/// caught inside the step (`law::PyLaw`); the hook moves it into that slot and asks the
+/// run to stop at every pause, without the [`POLL`] delay.
+pub fn interrupts(
+    progress: Option<Py<PyAny>>,
+    end: f64,
+    kept: Option<Pending>,
+) -> (Interrupts, Pending) {
     let pending: Pending = Arc::new(Mutex::new(None));
     let last = Mutex::new(Instant::now());
     let slot = pending.clone();
     let stop_flags: Arc<Mutex<Option<Interrupts>>> = Arc::new(Mutex::new(None));
     let flags = stop_flags.clone();
+    let stop = move |e: PyErr, flags: &Mutex<Option<Interrupts>>| {
+        let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
+        if s.is_none() {
+            *s = Some(e);
+        }
+        if let Some(i) = flags.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
+            i.request_stop(libc_sigint());
+        }
+    };
     let hook = move |t: f64| {
+        if let Some(e) = kept.as_ref().and_then(take) {
+            stop(e, &flags);
+            return;
+        }
         {
             let mut l = last.lock().unwrap_or_else(|e| e.into_inner());
             if l.elapsed() < POLL {
@@ -44,13 +63,7 @@ pub fn interrupts(progress: Option<Py<PyAny>>, end: f64) -> (Interrupts, Pending
             None
         });
         if let Some(e) = err {
-            let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
-            if s.is_none() {
-                *s = Some(e);
-            }
-            if let Some(i) = flags.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
-                i.request_stop(libc_sigint());
-            }
+            stop(e, &flags);
         }
     };
     let interrupts = Interrupts::polled(Arc::new(hook));

@@ -227,11 +227,7 @@ pub fn end_time(model: &Model) -> f64 {
 
 /// One run of `deck` into `out` (None: memory), with the GIL released; what it returns and
 /// the Python error that stopped it, if any.
-fn execute(
-    deck: &Deck,
-    out: Option<&Path>,
-    interrupts: &Interrupts,
-) -> Result<RunData, (u8, String)> {
+fn execute(deck: &Deck, out: Option<&Path>, interrupts: &Interrupts) -> Outcome {
     if deck.model.modes.is_some() {
         return Err((
             app::EXIT_BAD_INPUT,
@@ -295,7 +291,7 @@ pub fn run_deck(
             "progress must be a callable of (t, end)",
         ));
     }
-    let (interrupts, pending) = poll::interrupts(progress, end_time(&deck.model));
+    let (interrupts, pending) = poll::interrupts(progress, end_time(&deck.model), None);
     let result = py.detach(|| execute(&deck, out.as_deref(), &interrupts));
     let data = result.map_err(|(c, m)| run_error(c, m))?;
     if let Some(err) = poll::take(&pending) {
@@ -305,6 +301,9 @@ pub fn run_deck(
     }
     Ok(data)
 }
+
+/// What a run returns, or its exit code and message.
+type Outcome = Result<RunData, (u8, String)>;
 
 /// Runs several decks on `threads` threads, the GIL released (see `mecano.run_many`).
 /// Ctrl-C stops every run at the end of its step; the KeyboardInterrupt then carries the
@@ -334,10 +333,10 @@ pub fn run_many(
         .max(1);
     // One set of flags for all: Ctrl-C (seen by whichever run polls on the main thread
     // first... none does: the main thread waits below and polls itself).
-    let (interrupts, pending) = poll::interrupts(None, 0.0);
+    let (interrupts, pending) = poll::interrupts(None, 0.0, None);
     let quiet = interrupts.flags();
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<std::sync::Mutex<Option<Result<RunData, (u8, String)>>>> =
+    let results: Vec<std::sync::Mutex<Option<Outcome>>> =
         decks.iter().map(|_| std::sync::Mutex::new(None)).collect();
     py.detach(|| {
         std::thread::scope(|s| {

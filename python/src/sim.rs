@@ -33,6 +33,12 @@ struct Input {
     explicit: Option<Py<PyAny>>,
 }
 
+/// An explicit law to call before a step: its input, the callable, the value it sets.
+type ExplicitLaw = (u32, Py<PyAny>, Arc<HeldValue>);
+
+/// A 3-vector handed to Python.
+type Vector<'py> = Bound<'py, PyArray1<f64>>;
+
 /// A started run.
 struct Running {
     integ: Integrator,
@@ -55,6 +61,8 @@ pub struct Simulation {
     inner: Mutex<Inner>,
     /// The error a Python law raised inside a step.
     pending: Pending,
+    /// A KeyboardInterrupt a law caught inside a step: the run stops at the step's end.
+    ctrl_c: Pending,
     /// Set by a failing law: the step under way is given up.
     abort: Arc<AtomicBool>,
     /// Whether an explicit law is being called (it may read the simulation, not step it).
@@ -122,7 +130,7 @@ impl Inner {
             let mut integ = solver::prepare(&self.model)
                 .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.deck.name)))?;
             integ.abort = Some(abort.clone());
-            let mut rec = memory::recorder(&self.model, &self.deck.name, self.deck.refine, &integ);
+            let mut rec = recorder(self, &integ);
             let none = mecano::interrupt::Interrupts::none();
             let stepper = Stepper::start(
                 &self.model,
@@ -194,6 +202,7 @@ impl Simulation {
                 failed: None,
             }),
             pending: Arc::new(Mutex::new(None)),
+            ctrl_c: Arc::new(Mutex::new(None)),
             abort: Arc::new(AtomicBool::new(false)),
             in_law: AtomicBool::new(false),
         }
@@ -202,8 +211,10 @@ impl Simulation {
     /// Calls the explicit laws with `(t, sim)` and holds their values over the next step.
     fn explicit_laws(slf: &Bound<'_, Self>) -> PyResult<()> {
         let this = slf.get();
-        let (laws, t): (Vec<(u32, Py<PyAny>, Arc<HeldValue>)>, f64) = {
+        let (laws, t): (Vec<ExplicitLaw>, f64) = {
             let inner = this.lock()?;
+            // A failed simulation says so before any law is called again.
+            inner.usable()?;
             let laws = inner
                 .inputs
                 .iter()
@@ -217,11 +228,16 @@ impl Simulation {
                 .collect();
             (laws, inner.run.as_ref().map_or(0.0, |r| r.integ.t))
         };
+        let mut changed = false;
         for (id, f, held) in laws {
             this.in_law.store(true, Ordering::SeqCst);
             let r = f.call1(slf.py(), (t, slf));
             this.in_law.store(false, Ordering::SeqCst);
             let fail = |e: PyErr| -> PyErr {
+                // Ctrl-C in the law, between steps: the simulation stops there, usable.
+                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(slf.py()) {
+                    return e;
+                }
                 if let Ok(mut inner) = this.lock() {
                     inner.failed = Some(format!("the law of input {id} raised at t = {t} s"));
                 }
@@ -242,7 +258,23 @@ impl Simulation {
                     "the law of input {id} returned {v} at t = {t} s"
                 ))));
             }
+            changed |= held.get() != v;
             held.set(v);
+        }
+        // Before the first step the initial accelerations were computed with the inputs'
+        // `value`: recomputed with the laws' values at t = 0, so the first step starts
+        // from the equations of motion it integrates (the arm held at rest by its law
+        // stays at rest). The t = 0 row already recorded keeps the former accelerations.
+        if changed {
+            let mut inner = this.lock()?;
+            if let Some(r) = inner.run.as_mut()
+                && r.integ.stats.steps == 0
+                && r.integ.t == 0.0
+            {
+                r.integ
+                    .consistent_accelerations()
+                    .map_err(|f| MecanoError::new_err(f.to_string()))?;
+            }
         }
         Ok(())
     }
@@ -265,7 +297,7 @@ impl Simulation {
             .run
             .as_ref()
             .map_or(end_time(&inner.model), |r| r.stepper.end);
-        let (interrupts, stop) = poll::interrupts(None, end);
+        let (interrupts, stop) = poll::interrupts(None, end, Some(this.ctrl_c.clone()));
         let inner_ref: &mut Inner = &mut inner;
         inner_ref.start(&this.abort)?;
         let run = inner_ref.run.as_mut().expect("started");
@@ -282,6 +314,8 @@ impl Simulation {
             go(stepper, integ, &mut obs)
         });
         let law_error = poll::take(&this.pending);
+        // Ctrl-C caught by a law in the last step (if the pauses did not see it).
+        let ctrl_c = poll::take(&this.ctrl_c);
         let t = run.integ.t;
         if let Some(e) = law_error {
             inner.failed = Some(format!("a law raised at t = {t} s: {e}"));
@@ -294,7 +328,9 @@ impl Simulation {
                 return Err(MecanoError::new_err(e.to_string()));
             }
         };
-        if let Some(e) = poll::take(&stop) {
+        // A step that failed is a failure, whatever Ctrl-C a law caught in it.
+        let ctrl_c = ctrl_c.filter(|_| outcome != StepOutcome::Failed);
+        if let Some(e) = poll::take(&stop).or(ctrl_c) {
             // Ctrl-C: stopped at the end of a step; the simulation can go on.
             if let Some(r) = inner.run.as_mut() {
                 r.stepper.clear_stop();
@@ -409,6 +445,7 @@ impl Simulation {
                             input: id,
                             pending: self.pending.clone(),
                             abort: self.abort.clone(),
+                            interrupt: self.ctrl_c.clone(),
                         }))
                     }
                     other => {
@@ -597,10 +634,7 @@ impl Simulation {
     }
 
     /// A joint's reaction now: (force N, moment N·m), global, on its second node.
-    fn reaction<'py>(
-        slf: &Bound<'py, Self>,
-        element: u32,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn reaction<'py>(slf: &Bound<'py, Self>, element: u32) -> PyResult<(Vector<'py>, Vector<'py>)> {
         let (h, row) = started(slf)?.element_row(element)?;
         let col = |name: &str| h.iter().position(|c| c == name).map(|i| row[i]);
         match (
@@ -628,13 +662,31 @@ impl Simulation {
         Ok(self.lock()?.failed.clone())
     }
 
-    /// The histories so far (the deck's OUTPUT selection) and the summary.
+    /// The histories so far (the deck's OUTPUT selection) and the summary: `complete`
+    /// only once the deck's end time is reached without failure; a law's error (which
+    /// the solver did not see) is the summary's `failure`, a simulation short of its end
+    /// is `stop: {"reason": "paused"}`.
     fn run_data(slf: &Bound<'_, Self>) -> PyResult<RunData> {
         let this = slf.get();
         let mut inner = this.lock()?;
+        let deck_end = end_time(&inner.model);
+        let failed = inner.failed.clone();
         let r = inner.start(&this.abort)?;
         let report = r.stepper.report(&r.integ);
-        let summary = r.rec.summary(&r.integ, Some(&report));
+        let mut summary = r.rec.summary(&r.integ, Some(&report));
+        let (t, steps) = (r.integ.t, r.integ.stats.steps);
+        let reached = t >= deck_end - 1e-9 * deck_end.abs().max(1.0);
+        if failed.is_some() || !reached {
+            summary["complete"] = false.into();
+        }
+        if let Some(why) = failed
+            && summary["failure"].is_null()
+        {
+            summary["failure"] = serde_json::json!({ "message": why, "time": t, "step": steps });
+            summary["stop"] = serde_json::json!({ "reason": "failed", "time": t, "step": steps });
+        } else if !reached && summary["stop"].is_null() {
+            summary["stop"] = serde_json::json!({ "reason": "paused", "time": t, "step": steps });
+        }
         Ok(RunData::from_memory(
             r.rec.nodes.clone(),
             r.rec.elements.clone(),
@@ -762,7 +814,7 @@ impl Simulation {
                 "{e} (a simulation saved with inputs is restored by one with the same inputs: add them, then sim.restore(dir))"
             ))
         })?;
-        let mut rec = memory::recorder(&inner.model, &inner.deck.name, inner.deck.refine, &integ);
+        let mut rec = recorder(&inner, &integ);
         let none = mecano::interrupt::Interrupts::none();
         let stepper = Stepper::start(
             &inner.model,
@@ -781,6 +833,27 @@ impl Simulation {
         });
         Ok(())
     }
+}
+
+/// The recorder of a Simulation's histories. With inputs, the summary's
+/// `step_resolution` block (modes about the initial state, `modes::run_summary`) is not
+/// computed: it would call the Python laws with the GIL held, and on
+/// decks/pd_flexible_arm.dat with a PD law the dense eigensolver of that block does not
+/// return (faer's real Schur; the CLI hangs the same way with a deck PID on that arm).
+fn recorder(inner: &Inner, integ: &Integrator) -> Recorder {
+    if inner.inputs.is_empty() {
+        return memory::recorder(&inner.model, &inner.deck.name, inner.deck.refine, integ);
+    }
+    let mut rec = Recorder::new(&inner.deck.name, &inner.model, &integ.sys);
+    rec.refine = inner.deck.refine.max(1);
+    rec.notes.insert(
+        mecano::modes::run_summary::KEY.into(),
+        serde_json::json!({
+            "computed": false,
+            "reason": "not computed: a Simulation with inputs (use mecano.modes on the deck)",
+        }),
+    );
+    rec
 }
 
 /// The simulation's state, started.

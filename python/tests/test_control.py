@@ -235,3 +235,88 @@ def test_two_threads_on_one_simulation_get_an_exception(root):
     # Whichever came second while the first stepped was refused (or found t reached).
     for e in errors:
         assert "another thread" in str(e)
+
+
+def test_a_law_error_carries_its_python_traceback(root):
+    """The error is the law's own exception: its traceback reaches into the law."""
+    sim = mecano.Simulation(arm(root, 1e-3))
+
+    def faulty_controller(t, s):
+        return {}["gain"]  # KeyError inside the user's code
+
+    sim.add_input(hinge=1, law=faulty_controller, sensors=[("angle", 1)])
+    with pytest.raises(KeyError) as e:
+        sim.step()
+    assert any(entry.name == "faulty_controller" for entry in e.traceback)
+
+
+def test_an_explicit_law_that_raises_stops_the_simulation(root):
+    sim = mecano.Simulation(arm(root, 1e-3))
+
+    def law(t, sim):
+        if t > 0.01:
+            raise RuntimeError("explicit controller bug")
+        return 9.81
+
+    sim.add_input(hinge=1, law=law, tangent="explicit")
+    with pytest.raises(RuntimeError, match="explicit controller bug"):
+        sim.advance(0.1)
+    assert sim.failed and "raised" in sim.failed
+    run = sim.run()
+    assert not run.complete and 0.01 <= run.node(2).t[-1] < 0.012
+    with pytest.raises(mecano.SimulationError, match="failed"):
+        sim.advance(0.2)
+
+
+@pytest.mark.parametrize(
+    "call, error",
+    [
+        (lambda sim: sim.add_input(hinge=1, value=float("nan")), ValueError),
+        (lambda sim: sim.add_input(hinge=1, value="big"), TypeError),
+        (lambda sim: sim.add_input(node=2, axis=3), ValueError),
+        (lambda sim: sim.add_input(hinge=1, tangent="exact", law=lambda t, s: 0.0), ValueError),
+        (lambda sim: sim.advance("1.0"), TypeError),
+        (lambda sim: sim.position("2"), TypeError),
+        (lambda sim: sim.velocity(2, axis=5), ValueError),
+        (lambda sim: sim.joint_angle(2), KeyError),  # a MASS, not a HINGE
+        (lambda sim: sim.reaction(2), ValueError),  # a MASS has no reaction
+        (lambda sim: sim.set_input(99, 1.0), KeyError),
+    ],
+)
+def test_bad_arguments_raise_python_exceptions(root, call, error):
+    sim = mecano.Simulation(arm(root, 1e-3))
+    with pytest.raises(error):
+        call(sim)
+
+
+def test_pd_law_on_the_flexible_arm_starts_and_steps(root):
+    """examples/python/pd_flexible_arm.py's set-up: starting it used to hang in the
+    run summary's modal block (a dense eigensolve that did not return, with the GIL
+    held). Run in a child process so that a regression fails instead of hanging."""
+    import subprocess
+    import sys
+
+    code = f"""
+import math, mecano
+sim = mecano.Simulation(mecano.Deck.read({str(root / 'decks' / 'pd_flexible_arm.dat')!r}))
+sim.add_input(hinge=1, law=lambda t, s: 20.0 * (0.1 - s.joint_angle(1)) - 2.0 * s.joint_rate(1),
+              sensors=[("angle", 1), ("rate", 1)])
+sim.advance(0.05)
+run = sim.run()
+assert run.summary["step_resolution"]["computed"] is False
+print(sim.t, sim.joint_angle(1))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    t, angle = map(float, out.stdout.split())
+    assert t == pytest.approx(0.05) and 0 < angle < 0.1
+
+
+def test_an_explicit_law_sets_the_initial_accelerations(root):
+    """The explicit law's value at t = 0 (not the input's default `value` = 0) is what the
+    start's accelerations balance: a law that holds the arm up against gravity (9.81 N m)
+    keeps it at rest from the first step, as the held input does."""
+    sim = mecano.Simulation(arm(root, 1e-3))
+    sim.add_input(hinge=1, law=lambda t, sim: 9.81, tangent="explicit")
+    sim.advance(0.1)
+    assert abs(sim.joint_angle(1)) < 1e-12

@@ -107,3 +107,34 @@ def test_modes_are_the_cli_numbers(root, tmp_path, cli):
     cli_hz = [float(l.split(",")[k]) for l in lines[1:]]
     assert np.array_equal(m["frequency_hz"], np.array(cli_hz))
     assert m["shapes"].shape == (4, len(m["nodes"]), 6)
+
+
+def test_a_thread_pool_of_runs_equals_serial_runs(root):
+    """mecano.run on a ThreadPoolExecutor (the GIL released): the serial histories."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    decks = [short_deck(root, 0.1).with_parameters(A=a) for a in (1.0, 2.0, 3.0, 3.1)]
+    with ThreadPoolExecutor(4) as pool:
+        threaded = list(pool.map(mecano.run, decks))
+    for d, p in zip(decks, threaded):
+        s = mecano.run(d)
+        assert np.array_equal(p.node(2).array, s.node(2).array)
+        assert np.array_equal(p.energy.array, s.energy.array)
+
+
+@pytest.mark.parametrize(
+    "call, error",
+    [
+        (lambda r: mecano.run(r / "decks" / "driven_arm.dat", out=3), TypeError),
+        (lambda r: mecano.run(r / "decks" / "driven_arm.dat", progress=3), TypeError),
+        (lambda r: mecano.run_many([r / "decks" / "driven_arm.dat"], out=[]), ValueError),
+        (lambda r: mecano.run_many([3]), TypeError),
+        (lambda r: mecano.modes(r / "decks" / "cantilever_modes.dat", at=float("nan")), ValueError),
+        (lambda r: mecano.modes(r / "decks" / "cantilever_modes.dat", at=[1]), TypeError),
+        (lambda r: mecano.modes(r / "decks" / "cantilever_modes.dat", count=0), ValueError),
+        (lambda r: mecano.open(r / "decks"), mecano.MecanoError),
+    ],
+)
+def test_bad_arguments_of_runs_raise_python_exceptions(root, call, error):
+    with pytest.raises(error):
+        call(root)
