@@ -99,3 +99,40 @@ fn the_grazing_contact_at_20_73_s_is_crossed_without_an_energy_jump() {
         "an energy of {worst:e} J was written: the guard let a jump through"
     );
 }
+
+/// A run the guard cannot check says so (issue 35 §0, never silent): the fuzz case
+/// `benches/fuzz/open/7_2002.dat` (HHT α = 0, `TOLINC 4.6e-5` on beams of EA 4e8 N) passes
+/// its first step only by the allowance for Newton's tolerance, 79 J (`c_v τ (…) +
+/// τ L n f_ref`), with 63 J in play; its strain energy then grows from 12.7 J to 4.13e4 J
+/// with no work. The run still completes (the guard's bound is not met by a tighter one
+/// yet: benches/fuzz/open/README.md), but it prints the warning and lists the notice in
+/// `summary.json` with the step's time, the allowance and the energy in play, so that the
+/// number is not read as checked. Without the notice the test fails on both asserts.
+#[test]
+fn a_run_whose_newton_tolerance_voids_the_guard_says_so() {
+    let tmp = TempDir::new("energy_unchecked");
+    let out = tmp.join("out");
+    let deck = common::root().join("benches/fuzz/open/7_2002.dat");
+    let o = Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg(&deck)
+        .args(["-q", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("the energy guard could not check the run"),
+        "{stderr}"
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let notice = s["notices"]
+        .as_array()
+        .and_then(|a| a.iter().find(|n| n["kind"] == "energy_unchecked"))
+        .unwrap_or_else(|| panic!("no energy_unchecked notice: {s}"));
+    let (allowance, play) = (
+        notice["allowance"].as_f64().unwrap(),
+        notice["play"].as_f64().unwrap(),
+    );
+    assert!(allowance > play && play > 0.0, "{notice}");
+}
