@@ -82,7 +82,7 @@ impl Integrator {
             self.sys.elements.len(),
         )?;
         // Passed only by the allowance for Newton's tolerance, larger than the energy in
-        // play: the check is void from here (benches/fuzz/open: 79 J of allowance with 17 J
+        // play: the check is void from here (benches/fuzz/open: 79 J of allowance with 63 J
         // in play let 4.13e4 J be created), said once, never silent.
         let play = old.play.max(new.play);
         if newton > play
