@@ -5,6 +5,8 @@
 //! interrupted (SIGINT or SIGTERM: whole rows kept, a checkpoint to go on from with
 //! `mecano-rs resume`).
 
+pub use locate::{locate, located_build_error};
+mod locate;
 pub mod memory;
 pub mod modes;
 pub mod outdir;
@@ -185,12 +187,6 @@ pub fn load_source(path: &Path, set: &[(String, f64)], refine: u32) -> Result<(M
     Ok((model, text))
 }
 
-/// `path:line:col` of the byte `span.start` of the deck text `text` read from `path`.
-pub fn locate(path: &Path, text: &str, span: crate::model::Span) -> String {
-    let (line, col) = deck::line_col(text, span.start);
-    format!("{}:{line}:{col}", path.display())
-}
-
 /// Refines the model by `refine` (0 or 1: as written), then checks that the whole of it —
 /// nodes, elements, the unknowns' system, the output's buffers — fits in the memory the
 /// process may take (`--max-memory`, else what is available: [`crate::model::budget`]).
@@ -287,29 +283,6 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
             eprintln!("error: {}", located_build_error(path, &e));
             EXIT_BAD_INPUT
         }
-    }
-}
-
-/// `file:line:col` of a byte offset of the deck at `path` (its text read again), or the
-/// path alone when the deck cannot be read again (a pipe is not: it was read once).
-fn locate_offset(path: &Path, offset: usize) -> String {
-    let regular = std::fs::metadata(path).is_ok_and(|m| m.is_file());
-    match deck::read_text(path).ok().filter(|_| regular) {
-        Some(text) => locate(path, &text, crate::model::Span::new(offset, offset)),
-        None => path.display().to_string(),
-    }
-}
-
-/// A build error of the solver with its place in the deck where it has one (nodes whose
-/// motion is undetermined point at their NODES card).
-pub fn located_build_error(path: &Path, e: &solver::BuildError) -> String {
-    match e {
-        solver::BuildError::Undetermined(nodes) => nodes
-            .iter()
-            .map(|n| format!("{}: {n}", locate_offset(path, n.span.start)))
-            .collect::<Vec<_>>()
-            .join("\nerror: "),
-        other => format!("{}: {other}", path.display()),
     }
 }
 

@@ -436,55 +436,6 @@ pub enum DeckErrorKind {
     },
 }
 
-/// Where an EXPR function could not be shown finite ([`DeckErrorKind::FunctionNotFinite`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct FunctionNotFinite {
-    /// The function's number.
-    pub id: u32,
-    /// The expression.
-    pub text: String,
-    /// The innermost part whose enclosure blew up.
-    pub part: String,
-    /// `value`, `first derivative` or `second derivative`.
-    pub what: &'static str,
-    /// The variable (`t`, `the deflection`).
-    pub var: &'static str,
-    /// Where, rounded to 9 digits.
-    pub at: f64,
-    /// The variable's unit.
-    pub unit: &'static str,
-    /// Whether the `f64` evaluation itself is not finite there.
-    pub sure: bool,
-    /// The domain checked.
-    pub domain: (f64, f64),
-}
-
-impl fmt::Display for FunctionNotFinite {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let FunctionNotFinite {
-            id,
-            text,
-            part,
-            what,
-            var,
-            at,
-            unit,
-            sure,
-            domain,
-        } = self;
-        let how = if *sure {
-            "is not finite"
-        } else {
-            "could not be shown finite (its enclosure stays unbounded)"
-        };
-        write!(
-            f,
-            "function {id}: `{part}` in `{text}`: its {what} {how} at {var} = {at} {unit} ({var} in [{}, {}] {unit} is the domain the run can reach; shown by interval arithmetic, which bounds the expression at every double of it)",
-            domain.0, domain.1
-        )
-    }
-}
-
 /// One mistake in a deck: what, and where (byte span in the source; `None` for file errors).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeckError {
@@ -614,7 +565,9 @@ impl Diagnostic for DeckError {
 }
 
 mod echo;
+mod function;
 mod list;
 pub use echo::{ECHO_CHARS, short};
+pub use function::FunctionNotFinite;
 pub use list::DeckErrors;
 pub(crate) use list::line_col;

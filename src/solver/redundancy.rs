@@ -441,9 +441,9 @@ pub fn singular_position(sys: &System, nodes: &[NodeState], t: f64) -> Option<St
     })
 }
 
-/// The equations dependent to within `tol`, not removed at the start, listed by element.
-fn near_dependent(sys: &System, nodes: &[NodeState], t: f64, tol: f64) -> Option<String> {
-    let r = detect_with(sys, nodes, t, tol);
+/// The equations of `r` not removed at the start, listed by element as
+/// `E (equation k (motion), …)`, with their count; `None` when there are none.
+fn listed_by_element(sys: &System, r: &Redundancy) -> Option<(usize, String)> {
     let removed = sys.removed_equations();
     let new: Vec<&Redundant> = r
         .removed
@@ -461,44 +461,25 @@ fn near_dependent(sys: &System, nodes: &[NodeState], t: f64, tol: f64) -> Option
             _ => by_el.push((x.id, vec![what])),
         }
     }
-    Some(
-        by_el
-            .iter()
-            .map(|(id, eqs)| format!("{id} (equation {})", eqs.join(", ")))
-            .collect::<Vec<_>>()
-            .join("; "),
-    )
+    let list = by_el
+        .iter()
+        .map(|(id, eqs)| format!("{id} (equation {})", eqs.join(", ")))
+        .collect::<Vec<_>>()
+        .join("; ");
+    Some((new.len(), list))
+}
+
+/// The equations dependent to within `tol`, not removed at the start, listed by element.
+fn near_dependent(sys: &System, nodes: &[NodeState], t: f64, tol: f64) -> Option<String> {
+    listed_by_element(sys, &detect_with(sys, nodes, t, tol)).map(|(_, list)| list)
 }
 
 /// The diagnosis of redundant constraints at a state where the iteration matrix could
 /// not be factored, naming the joints and their equations, or `None` when the
 /// constraints are independent there. Equations removed at the start do not count.
 pub fn redundancy_error(sys: &System, nodes: &[NodeState]) -> Option<String> {
-    let r = detect(sys, nodes, 0.0);
-    let removed = sys.removed_equations();
-    let new: Vec<&Redundant> = r
-        .removed
-        .iter()
-        .filter(|x| !removed.contains(&x.global))
-        .collect();
-    if new.is_empty() {
-        return None;
-    }
-    let mut by_el: Vec<(ElementId, Vec<String>)> = Vec::new();
-    for x in &new {
-        let what = format!("{} ({})", x.equation + 1, x.motion);
-        match by_el.last_mut() {
-            Some((id, v)) if *id == x.id => v.push(what),
-            _ => by_el.push((x.id, vec![what])),
-        }
-    }
-    let list: Vec<String> = by_el
-        .iter()
-        .map(|(id, eqs)| format!("{id} (equation {})", eqs.join(", ")))
-        .collect();
+    let (count, list) = listed_by_element(sys, &detect(sys, nodes, 0.0))?;
     Some(format!(
-        "redundant constraints at this position: {} of the constraint equations depend on the others: {}. The mechanism is at a singular position (links aligned, a loop that locks), where the joints block fewer motions than their equations",
-        new.len(),
-        list.join("; "),
+        "redundant constraints at this position: {count} of the constraint equations depend on the others: {list}. The mechanism is at a singular position (links aligned, a loop that locks), where the joints block fewer motions than their equations",
     ))
 }
