@@ -244,11 +244,6 @@ impl Session<'_> {
         let exact = report.interrupted.is_none() && integ.exact_reactions();
         report.stats = integ.stats;
         notices_into(&mut self.writer, integ);
-        for n in &integ.notices {
-            if matches!(n, solver::notice::Notice::EnergyUnchecked { .. }) {
-                eprintln!("warning: {n}");
-            }
-        }
         if report.interrupted.is_some() {
             let signal = self.interrupts.signal_name().unwrap_or("a stop request");
             self.writer

@@ -10,8 +10,8 @@
 //! `R(s)` (at `s`, the start of the run of steps checked) by more than
 //!
 //! ```text
-//! g · E_osc(s)  +  Σ_{steps since s} h (|ΔP_ext| + |ΔP_drive| + |ΔP_damp|)
-//!               +  max_{steps since s} (|Ω|_max h)² T  +  floor
+//! g · E_osc(s)  +  Σ_{steps since s} [h (|ΔP_ext| + |ΔP_drive| + |ΔP_damp|) + N]
+//!               +  max_{steps since s} min(|Ω|_max h, ½)² T  +  floor
 //! ```
 //!
 //! (`docs/stability.md`, "The energy guard's bound", derives it):
@@ -26,13 +26,16 @@
 //!   `h P_{n+1}`, a bracket of width `h |ΔP|` around the trapezoid (which errs by at most
 //!   half of it there; the whole width also covers a power that bends within the step:
 //!   the torque pulse of `pendulum_converged.dat`, ESDIRK5, needs 0.68 of it).
+//! - `N`, what Newton leaves of each step: states within δ (the last increment, at most
+//!   the tolerance) of the discrete solution, whose energies are uncertain by
+//!   `c_v δ (L_ref √(2T M) + √(2T J)) + δ L_ref n f_ref` (`c_v = ∂v/∂u` of the step); each
+//!   step starts from the state the previous one left, so these add up.
 //! - The rotation update `R exp(hΩ)` of a body whose `Ω` turns is second order: the
 //!   energy it conserves differs from `T` by `O((|Ω| h)²) T` (the free rigid body's energy
-//!   error, bounded and oscillating: Simo & Wong 1991), which a run of steps may show.
+//!   error, bounded and oscillating: Simo & Wong 1991), which a run of steps may show. The
+//!   estimate is asymptotic: it is used up to [`ROTATION_RESOLVED`] rad per step.
 //! - `floor`: the round-off of the equilibrium (`Integrator::residual_floor` over the
-//!   model's size) and of the energies' sums (`64 ε n_elements E_play`), and what Newton
-//!   leaves: states within the increment tolerance τ, whose energies are uncertain by
-//!   `c_v τ (L_ref √(2T M) + √(2T J)) + τ L_ref n f_ref` (`c_v = ∂v/∂u` of the step).
+//!   model's size) and of the energies' sums (`64 ε n_elements E_play`).
 //!
 //! A step that fails it is refused and retried shorter (its modes back under `ωh ≤ π`,
 //! where the bound holds); at the smallest step the run stops with the diagnosis. A
@@ -44,6 +47,12 @@ pub mod bound;
 
 use super::system::System;
 use crate::elements::NodeState;
+
+/// The largest turn per step, rad, for which the rotation update's energy error is
+/// allowed its asymptotic size `(|Ω| h)² T`: a step that turns a node further resolves
+/// nothing of its rotation, and gets no more allowance than this turn's (a quarter of `T`),
+/// so that energy created there is refused and the step retried shorter.
+pub const ROTATION_RESOLVED: f64 = 0.5;
 
 /// An energy the guard refused: what a step or a run of steps created, against its bound.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,7 +108,7 @@ pub struct Balance {
     pub t_min: f64,
     /// `E_osc = T + |U|` at `t_min`, J.
     pub osc: f64,
-    /// `Σ h(|ΔP_ext| + |ΔP_drive| + |ΔP_damp|)` over the steps since `t_min`, J.
+    /// `Σ [h(|ΔP_ext| + |ΔP_drive| + |ΔP_damp|) + N]` over the steps since `t_min`, J.
     pub quadrature: f64,
     /// Largest `(|Ω|_max h)² T` since `t_min`, J.
     pub rotation: f64,
@@ -135,8 +144,8 @@ pub fn measure(sys: &System, nodes: &[NodeState], t: f64) -> Measure {
 }
 
 /// The step from `old` to `new` over `h` (`drive`: the drivers' powers at both ends, W),
-/// checked against the run's record (module docs) with the scheme's `g` and the round-off
-/// `floor`, J. `t_new` is the step's end time. A non-finite energy is refused.
+/// checked against the run's record (module docs) with the scheme's `g`, the round-off
+/// `floor` and what Newton left of this step, `newton` (accumulated), J. `t_new` is the step's end time. A non-finite energy is refused.
 #[allow(clippy::too_many_arguments)]
 pub fn check(
     record: &Balance,
@@ -147,6 +156,7 @@ pub fn check(
     t_new: f64,
     g: f64,
     floor: f64,
+    newton: f64,
     n_elements: usize,
 ) -> Result<Passed, EnergyJump> {
     let mut b = *record;
@@ -164,10 +174,10 @@ pub fn check(
     let quadrature = b.quadrature
         + h * ((new.p_ext - old.p_ext).abs()
             + (drive.1 - drive.0).abs()
-            + (new.p_damp - old.p_damp).abs());
-    let rotation = b
-        .rotation
-        .max((old.w_max.max(new.w_max) * h).powi(2) * old.kinetic.max(new.kinetic));
+            + (new.p_damp - old.p_damp).abs())
+        + newton;
+    let turn = (old.w_max.max(new.w_max) * h).min(ROTATION_RESOLVED);
+    let rotation = b.rotation.max(turn.powi(2) * old.kinetic.max(new.kinetic));
     let floor = floor + 64.0 * f64::EPSILON * n_elements as f64 * old.play.max(new.play);
     let rise = residual - b.min;
     let bound = g * b.osc + quadrature + rotation + floor;
@@ -240,6 +250,7 @@ mod tests {
             1e-3,
             g,
             0.0,
+            0.0,
             1,
         )
         .unwrap()
@@ -258,6 +269,7 @@ mod tests {
                 1e-3,
                 0.0,
                 g,
+                0.0,
                 0.0,
                 1,
             ) {
@@ -289,6 +301,7 @@ mod tests {
             0.0,
             g,
             0.0,
+            0.0,
             1,
         );
         assert!(ok.is_ok(), "{ok:?}");
@@ -301,6 +314,7 @@ mod tests {
                 1e-3,
                 0.0,
                 g,
+                0.0,
                 0.0,
                 1
             )

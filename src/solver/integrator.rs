@@ -180,6 +180,10 @@ pub struct Integrator {
     /// The guard's measure of the accepted state, kept for the next step while nothing
     /// changed the state: (steps, restarts, t) when it was taken.
     pub(super) guard_cache: Option<(u64, u64, f64, crate::solver::energy_guard::Measure)>,
+    /// What the last converged Newton loop leaves of its solution, in the increment's
+    /// units (`m / L_ref`, rad): at most the increment tolerance (set by `newton_solve`,
+    /// read by the energy guard of the same step).
+    pub(super) newton_left: f64,
     /// Step size the numeric LU in `sys.matrix` was computed for (NaN = none valid): a later
     /// step of the same size starts from it (modified Newton).
     pub(super) lu_step: f64,
@@ -314,6 +318,7 @@ impl Integrator {
                 crate::solver::energy_guard::bound::run_bound(&AlphaParams::of(&scheme))
             },
             guard_cache: None,
+            newton_left: 0.0,
             sys,
         }
     }

@@ -45,17 +45,6 @@ pub enum Notice {
         /// Gauss–Newton iterations.
         iterations: u32,
     },
-    /// During the run: a step passed the energy guard only thanks to what Newton's
-    /// increment tolerance allows, and that allowance exceeded the energy in play — the
-    /// guard could not check the run from then on (`energy_guard`, docs/stability.md).
-    EnergyUnchecked {
-        /// End of the first such step, s.
-        time: f64,
-        /// The allowance for Newton's tolerance at that step, J.
-        allowance: f64,
-        /// The energy in play, J.
-        play: f64,
-    },
     /// Initial velocities changed to satisfy the constraints.
     VelocitiesProjected {
         /// Largest change of a node's velocity, m/s.
@@ -97,21 +86,13 @@ impl std::fmt::Display for Notice {
                 "assembly: the initial positions violated the constraints by up to {violation:.3e}; {iterations} Gauss–Newton iterations moved them onto the constraints, node {} by up to {moved:.3e} m, node {} turned by up to {turned:.3e} rad",
                 node.0, turned_node.0
             ),
-            Notice::EnergyUnchecked {
-                time,
-                allowance,
-                play,
-            } => write!(
-                f,
-                "from t = {time:.6e} s the energy guard could not check the run: a step passed it only by the allowance for Newton's increment tolerance, {allowance:.3e} J, more than the energy in play, {play:.3e} J; energy created there would not be seen (tighten TOLINC; docs/stability.md)"
-            ),
             Notice::VelocitiesProjected {
                 change,
                 angular_change,
                 node,
             } => write!(
                 f,
-                "the initial velocities were made consistent with the constraints (the smallest change in kinetic energy): by up to {change:.3e} m/s and {angular_change:.3e} rad/s (most at node {})",
+                "the initial velocities were made consistent with the constraints and fixities (the smallest change in kinetic energy): by up to {change:.3e} m/s and {angular_change:.3e} rad/s (most at node {})",
                 node.0
             ),
         }

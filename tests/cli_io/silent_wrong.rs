@@ -133,6 +133,7 @@ fn the_energy_guard_refuses_energy_no_work_paid_for_and_passes_a_resolved_step()
             h,
             g,
             floor,
+            0.0,
             n,
         )
     };

@@ -64,7 +64,9 @@ impl Integrator {
             .nodes
             .iter()
             .any(|s| s.v != Vector3::zeros() || s.w != Vector3::zeros());
-        self.consistent_start(n > nn && (drivers || moving))
+        // (Without constraints a moving start is still "projected": its fixed components'
+        // velocities are zeroed, the solve changes nothing else.)
+        self.consistent_start((n > nn && drivers) || moving)
     }
 
     /// Before the first step of a constrained model: the redundant constraint equations
@@ -301,6 +303,29 @@ impl Integrator {
         let n = self.sys.n_eq();
         let nn = self.sys.n_node_eq;
         let fixed = crate::solver::system::FIXED;
+        // A fixed component's velocity is zero (an INITIAL velocity along it contradicts
+        // the fixity: held, it would move the node in the energies but never in position,
+        // and the first step would create its kinetic energy out of nothing —
+        // tests/deck/energy/7_2002: a FIX TRANS node given V, 0.178 J at every step size).
+        let mut zeroed = vec![(0.0f64, 0.0f64); self.nodes.len()];
+        for ((node, d), z) in self
+            .nodes
+            .iter_mut()
+            .zip(&self.sys.node_dofs)
+            .zip(&mut zeroed)
+        {
+            for c in 0..6 {
+                if d[c] == fixed {
+                    if c < 3 {
+                        z.0 = z.0.hypot(node.v[c]);
+                        node.v[c] = 0.0;
+                    } else {
+                        z.1 = z.1.hypot(node.w[c - 3]);
+                        node.w[c - 3] = 0.0;
+                    }
+                }
+            }
+        }
         // Velocities in equation order, into the first nn entries of `zero` (restored below).
         let v = &mut sc.zero;
         for (i, d) in self.sys.node_dofs.iter().enumerate() {
@@ -347,8 +372,12 @@ impl Integrator {
             let (mut dv, mut dw, mut node) = (0.0f64, 0.0f64, 0);
             for (i, d) in self.sys.node_dofs.iter().enumerate() {
                 let get = |c: usize| if d[c] == fixed { 0.0 } else { rhs[d[c]] };
-                let v = Vector3::new(get(0), get(1), get(2)).norm();
-                let w = Vector3::new(get(3), get(4), get(5)).norm();
+                let v = Vector3::new(get(0), get(1), get(2))
+                    .norm()
+                    .hypot(zeroed[i].0);
+                let w = Vector3::new(get(3), get(4), get(5))
+                    .norm()
+                    .hypot(zeroed[i].1);
                 if v + w * self.sys.ref_length > dv + dw * self.sys.ref_length {
                     node = i;
                 }
