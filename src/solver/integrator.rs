@@ -160,6 +160,9 @@ pub struct Integrator {
     pub step_cap: f64,
     /// Adaptive time stepping (local error tolerances), `None` = fixed steps.
     pub adaptive: Option<crate::model::Adaptive>,
+    /// The run's length, s (its `END`): adaptive ESDIRK steps are allowed the tolerance in
+    /// proportion to their share of it (error per unit step, [`Self::embedded_error`]).
+    pub error_horizon: f64,
     /// Step the local error estimate proposes after the last accepted step (adaptive).
     pub error_next: f64,
     /// Steps no longer than this are never refused by [`crate::elements::Element::step_limit`] (the run's
@@ -303,6 +306,7 @@ impl Integrator {
             damping_work: 0.0,
             step_cap: f64::INFINITY,
             adaptive: None,
+            error_horizon: 1.0,
             error_next: f64::INFINITY,
             event_floor: 0.0,
             straddled: false,

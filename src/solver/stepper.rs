@@ -98,6 +98,7 @@ impl Stepper {
             integ.adaptive = adaptive.clone();
         }
         let adaptive = integ.adaptive.is_some();
+        integ.error_horizon = end;
         integ.event_floor = hmin;
         let mut failure = None;
         if resume.is_none() {

@@ -132,6 +132,7 @@ pub fn run(args: &StudyArgs) -> u8 {
         }
     };
     let _ = print_table(&report, &mut io::stdout().lock());
+    let _ = tolerance::print(&report, &mut io::stdout().lock());
     let _ = needs::print_needs(&report, &mut io::stdout().lock());
     if let Ok(m) = crate::app::modes::load(&args.deck, &[], opts.refine, None) {
         crate::modes::run_summary::study_lines(&m, &opts.steps, &mut io::stdout().lock());
@@ -143,8 +144,19 @@ pub fn run(args: &StudyArgs) -> u8 {
             return crate::app::EXIT_FAILED;
         }
     }
+    let mut written = "work_precision.svg/.png";
+    if tolerance::proportionality(&report).is_some() {
+        for ext in ["svg", "png"] {
+            let file = out_dir.join(format!("tolerance.{ext}"));
+            if let Err(e) = tolerance::draw(&report, &file) {
+                eprintln!("error: {}: {e}", file.display());
+                return crate::app::EXIT_FAILED;
+            }
+        }
+        written = "work_precision.svg/.png, tolerance.svg/.png";
+    }
     println!(
-        "written: {}/study.csv, study_windows.csv, study_needs.csv, work_precision.svg/.png",
+        "written: {}/study.csv, study_windows.csv, study_needs.csv, {written}",
         out_dir.display()
     );
     crate::app::EXIT_OK

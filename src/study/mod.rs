@@ -24,7 +24,8 @@
 //! velocity (error O(h⁴)) and geodesically in rotation.
 //!
 //! Files: `run.rs` (the runs and their errors per window), `report.rs` (CSV files and the
-//! printed table), `figure.rs` (the work–precision diagram), `space/` (the space–time
+//! printed table), `figure.rs` (the work–precision diagram), `tolerance.rs` (the adaptive
+//! runs' error against the tolerance: slope and diagram), `space/` (the space–time
 //! study: a ladder of meshes as well as of steps), `cli.rs` (`mecano-rs study`).
 
 mod cli;
@@ -35,6 +36,8 @@ mod report;
 mod run;
 /// The space–time study: a ladder of meshes as well as of steps.
 pub mod space;
+/// Tolerance proportionality: the adaptive runs' error against the tolerance asked.
+pub mod tolerance;
 
 pub use cli::{StudyArgs, run};
 pub use figure::draw_work_precision;

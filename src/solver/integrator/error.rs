@@ -8,7 +8,11 @@ impl Integrator {
     /// for rotations), `max(|e_x|/tol_pos, |e_r|/tol_rot)` over the nodes
     /// (Zienkiewicz & Xie, Earthquake Eng. Struct. Dyn. 20, 1991, eq. 9; the leading term
     /// of the local truncation error of Newmark-type schemes). ≤ 1 means acceptable.
+    /// The ESDIRK schemes use their embedded pair instead ([`Self::embedded_error`]).
     pub fn local_error(&self, h: f64, a: &crate::model::Adaptive) -> f64 {
+        if self.is_esdirk() {
+            return self.embedded_error(h, a);
+        }
         let c = h * h * (self.params.beta - 1.0 / 6.0).abs();
         let mut err: f64 = 0.0;
         for (old, new) in self.nodes.iter().zip(&self.trial) {

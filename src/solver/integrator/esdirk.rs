@@ -240,6 +240,60 @@ impl Integrator {
         unreachable!("the last stage returns")
     }
 
+    /// The error of the step just solved, by the scheme's embedded pair (Kennedy &
+    /// Carpenter 2016, § 2.3, weights `b̂`): per node, in the algebra of the step's start,
+    /// the position difference `e_x = h Σ_j (b_j − b̂_j) Û_j` (translation, rotation vector;
+    /// the last stage's `Û` from Newton's `U`) and the velocity difference
+    /// `e_v = h Σ_j (b_j − b̂_j) (v̇_j, Ω̇_j)`, measured as `max(|e_x|, T |e_v|)` against
+    /// TOLPOS (TOLROT), `T` the run's length: a velocity error made now displaces the
+    /// positions by up to `T |e_v|` by the end of the run. Max over the nodes; ≤ 1 acceptable.
+    ///
+    /// Why the velocity: with index-3 constraints both schemes are third order in the
+    /// positions, the embedded difference of ESDIRK5's positions is `O(h⁵)` while the
+    /// positions err by `O(h⁴)` per step, so controlling it alone left the global error
+    /// `∝ TOL^0.69`; the velocities' difference carries the order reduction (`O(h³)`, the
+    /// order of the global error), and with it the global error is `∝ TOL^1.02` (ESDIRK3:
+    /// `TOL^0.97`, whose `e_x` is already `O(h³)`) on the simple pendulum
+    /// (`tests/study.rs`, docs/accuracy.md "Accuracy asked for").
+    pub(super) fn embedded_error(&self, h: f64, a: &crate::model::Adaptive) -> f64 {
+        let st = self.esdirk.as_deref().expect("ESDIRK stages");
+        let tab = st.tab;
+        let last = tab.stages - 1;
+        let mut err = 0.0f64;
+        for (k, u) in self.u.iter().enumerate() {
+            let w_last = h * (tab.a[last][last] - tab.embedded[last]) / st.gh;
+            let mut e = [
+                (u[0] - st.known_u[k][0]) * w_last,
+                (u[1] - st.known_u[k][1]) * w_last,
+            ];
+            let wl = h * (tab.a[last][last] - tab.embedded[last]);
+            let mut ev = [self.trial[k].a * wl, self.trial[k].wd * wl];
+            for j in 0..last {
+                let w = h * (tab.a[last][j] - tab.embedded[j]);
+                e[0] += st.vel[k][j][0] * w;
+                e[1] += st.vel[k][j][1] * w;
+                ev[0] += st.acc[k][j][0] * w;
+                ev[1] += st.acc[k][j][1] * w;
+            }
+            // A velocity error made now displaces the positions by up to `e_v T` by the
+            // end of the run (`T` = END): the position error the step is answerable for.
+            let t = self.error_horizon;
+            err = err
+                .max(e[0].norm().max(t * ev[0].norm()) / a.tol_position)
+                .max(e[1].norm().max(t * ev[1].norm()) / a.tol_rotation);
+        }
+        err
+    }
+
+    /// The step controller's exponent `1/(q + 1)`: the local error measure is
+    /// `O(h^{q+1})` with `q` the embedded order (ESDIRK) or 2 (HHT's Zienkiewicz–Xie).
+    pub(super) fn error_exponent(&self) -> f64 {
+        match self.esdirk.as_deref() {
+            Some(st) => 1.0 / f64::from(st.tab.embedded_order + 1),
+            None => 1.0 / 3.0,
+        }
+    }
+
     /// The trial state of the stage being solved from Newton's increment `u` (module
     /// docs): positions and orientations from `U`, velocities from the stage's algebra
     /// velocity `Û = (U − h Σ_{j<i} a_ij Û_j)/(γh)` (`Ω = T(U) Û` for rotations),

@@ -24,6 +24,12 @@ pub struct Tableau {
     pub gamma: f64,
     /// The Butcher matrix, zero-padded to [`MAX_STAGES`].
     pub a: [[f64; MAX_STAGES]; MAX_STAGES],
+    /// The weights `b̂` of the embedded scheme (Kennedy & Carpenter 2016, § 2.3): with `b`
+    /// the last row of `a`, `h Σ_j (b_j − b̂_j) k_j` estimates the local error of the
+    /// embedded solution, `O(h^{q̂+1})` — the step controller's measure (issue 37).
+    pub embedded: [f64; MAX_STAGES],
+    /// Order `q̂` of the embedded scheme.
+    pub embedded_order: u32,
 }
 
 /// `γ` of ESDIRK3: the root of `x³ − 3x² + 3x/2 − 1/6 = 0` in (1/3, 1/2) (Kennedy &
@@ -36,6 +42,18 @@ pub const ESDIRK3: Tableau = Tableau {
     order: 3,
     stages: 4,
     gamma: G3,
+    // The paper's § 5.2.1 `b̂` (as SUNDIALS' ARKODE lists them for ARK3(2)4L[2]SA, whose
+    // implicit tableau this is).
+    embedded: [
+        0.214_740_286_223_389_14,
+        -0.485_162_263_884_939_1,
+        0.868_725_002_520_387_6,
+        0.401_696_975_141_162_4,
+        0.0,
+        0.0,
+        0.0,
+    ],
+    embedded_order: 2,
     a: [
         [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
         [G3, G3, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -71,6 +89,18 @@ pub const ESDIRK5: Tableau = Tableau {
     order: 5,
     stages: 7,
     gamma: 0.184,
+    // The paper's § 7.2.2 `b̂`, its rationals with `b̂_1 = 1 − Σ_{j>1} b̂_j` evaluated exactly
+    // and rounded once.
+    embedded: [
+        -0.080_689_466_566_647_44,
+        -0.080_689_466_566_647_44,
+        0.182_899_684_613_435_53,
+        0.517_013_873_766_231,
+        0.426_599_731_302_454_3,
+        -0.104_326_857_967_134_98,
+        0.139_192_501_418_308_97,
+    ],
+    embedded_order: 4,
     a: [
         [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
         [0.184, 0.184, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -152,8 +182,13 @@ mod tests {
     /// The residuals of the order conditions of each order up to 5 (Butcher's rooted
     /// trees: 1, 1, 2, 4 and 9 of them), `max |Φ(t) − 1/γ(t)|` per order.
     fn order_residuals(t: &Tableau) -> [f64; 5] {
+        weights_residuals(t, &t.a[t.stages - 1])
+    }
+
+    /// [`order_residuals`] of the weights `b` on `t`'s stages.
+    fn weights_residuals(t: &Tableau, b: &[f64; MAX_STAGES]) -> [f64; 5] {
         let s = t.stages;
-        let b = &t.a[s - 1][..s];
+        let b = &b[..s];
         let c: Vec<f64> = (0..s).map(|i| t.c(i)).collect();
         let a = |v: &[f64]| -> Vec<f64> {
             (0..s)
@@ -218,6 +253,32 @@ mod tests {
         t.a[6][3] += 1e-12;
         let r = order_residuals(&t);
         assert!(r.iter().all(|e| *e > 1e-13), "perturbed: {r:?}");
+    }
+
+    /// The embedded weights transcribed: their order conditions hold up to `q̂` (to the
+    /// rounding of the coefficients) and fail at `q̂ + 1`, so `b − b̂` measures an error of
+    /// order `h^{q̂+1}`.
+    #[test]
+    fn each_embedded_scheme_has_its_order_and_not_the_next() {
+        for t in [&ESDIRK3, &ESDIRK5] {
+            let r = weights_residuals(t, &t.embedded);
+            let q = t.embedded_order as usize;
+            for (k, e) in r.iter().enumerate().take(q) {
+                assert!(
+                    *e < 1e-14,
+                    "{}: embedded order {} residual {e:e}",
+                    t.name,
+                    k + 1
+                );
+            }
+            assert!(
+                r[q] > 1e-6,
+                "{}: embedded order {} also holds",
+                t.name,
+                q + 1
+            );
+            assert!(t.embedded[t.stages..].iter().all(|w| *w == 0.0));
+        }
     }
 
     #[test]
