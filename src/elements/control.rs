@@ -25,6 +25,10 @@
 //! that the stages of the ESDIRK schemes integrate from the step's start too):
 //! `∂u/∂θ = −k_p − ½ k_i (t − t_n)`, `∂u/∂θ̇ = −k_d`.
 //!
+//! # A deck's law (`CONTROL … LAW`)
+//! `u(t, s)` an expression of the time and the sensors (`model::Expr`), its derivatives
+//! `∂u/∂sₖ` exact by forward-mode jets, one pass per sensor ([`crate::model::Expr::law`]).
+//!
 //! # Work
 //! The input's power `u ḋ` (`u θ̇`, `u v_a`) counts as external work in the energy balance
 //! ([`Element::input_power`]), so the energy guard pays for what a controller puts in.
@@ -68,6 +72,7 @@ enum Resolved {
         target: TimeLaw,
     },
     External(Arc<dyn Law>),
+    Expr(crate::model::Expr),
 }
 
 /// The controlled input element (see the module docs).
@@ -233,6 +238,7 @@ impl Control {
         let law = match &data.law {
             ControlLaw::Held(v) => Resolved::Held(v.clone()),
             ControlLaw::External(l) => Resolved::External(l.clone()),
+            ControlLaw::Expr(e) => Resolved::Expr(e.expr.clone()),
             ControlLaw::Pid(p) => {
                 if !matches!(
                     data.sensors.as_slice(),
@@ -326,6 +332,7 @@ impl Control {
                 kp * e + ki * (i_n + 0.5 * dt * (e_n + e)) + kd * ed
             }
             Resolved::External(l) => l.eval(t, s, grad),
+            Resolved::Expr(e) => e.law(t, s, grad),
         }
     }
 
