@@ -12,7 +12,7 @@
 mod build;
 mod cards;
 mod error;
-mod expr;
+pub(crate) mod expr;
 mod keywords;
 mod lex;
 pub mod limits;

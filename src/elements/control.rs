@@ -86,6 +86,8 @@ pub struct Control {
     angles: Vec<f64>,
     /// PID: `I_n`, `e_n`, `t_n` at the last accepted state.
     pid: [f64; 3],
+    /// Time of the last accepted state, s (for a diagnosis).
+    t_last: f64,
 }
 
 impl std::fmt::Debug for Control {
@@ -268,6 +270,7 @@ impl Control {
             law,
             angles: vec![0.0; n_angles],
             pid: [0.0; 3],
+            t_last: 0.0,
         })
     }
 
@@ -434,6 +437,7 @@ impl Element for Control {
     }
 
     fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {
+        self.t_last = ctx.t;
         let s = self.values(nodes);
         if let Resolved::Pid { target, .. } = &self.law
             && let Some(s) = &s
@@ -513,9 +517,20 @@ impl Element for Control {
     }
 
     fn diagnose(&self, nodes: &[NodeState]) -> Option<String> {
-        self.values(nodes).is_none().then(|| {
-            format!(
+        let Some(s) = self.values(nodes) else {
+            return Some(format!(
                 "{} (controlled input): a hinge it reads has no angle about its axis (torn apart)",
+                self.id
+            ));
+        };
+        // The law at the state, at the last accepted time (the step's own time is not
+        // known here): a law that is not finite there names its sensors' values.
+        let t = self.t_last;
+        let mut grad = vec![0.0; s.len()];
+        let u = self.law(t, &s, Some(&mut grad));
+        (!u.is_finite() || grad.iter().any(|g| !g.is_finite())).then(|| {
+            format!(
+                "{} (controlled input): its law is not finite at this state (value {u}, derivatives {grad:?} with the sensors s = {s:?}, t = {t} s)",
                 self.id
             )
         })
