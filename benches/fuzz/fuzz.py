@@ -253,7 +253,7 @@ class Deck:
         out.append(f"  {e} MASS {tip} M {num(r, 0.01, 100)}" + (f" INERTIA {num(r, 1e-4, 1)} {num(r, 1e-4, 1)} {num(r, 1e-4, 1)}" if r.random() < 0.5 else ""))
         extras = r.randrange(0, 3)
         for _ in range(extras):
-            k = r.choice(["RSPRING", "CAME", "RIGID", "PRESCRIBED", "SPRING", "MASS", "SPHERICAL", "BUSHING"])
+            k = r.choice(["RSPRING", "CAME", "RIGID", "PRESCRIBED", "SPRING", "MASS", "SPHERICAL", "BUSHING", "CONTROL"])
             e = self.el()
             if k == "RSPRING" and self.hinges:
                 out.append(f"  {e} RSPRING {self.hinges[0]} K {num(r, 0.1, 1e4)} C {num(r, 0.0, 1, log=False)}"
@@ -269,6 +269,14 @@ class Deck:
             elif k == "PRESCRIBED":
                 what = r.choice(["X", "Y", "Z", f"ROTATION AXIS {fmt3(unit(r))}"])
                 out.append(f"  {e} PRESCRIBED {tip} {what} FUNCTION {r.choice([3, 4, 6])}" + (f" AMPLITUDE {num(r, 1e-3, 1)}" if r.random() < 0.5 else ""))
+            elif k == "CONTROL":
+                # A law of sensors (issue 36 §6): a PD on a hinge, or a spring-damper force.
+                if self.hinges and r.random() < 0.5:
+                    h = self.hinges[0]
+                    out.append(f"  {e} CONTROL TORQUE {h} LAW ({num(r, 0.1, 1e4)}*(sin(t)-angle({h}))-{num(r, 0.0, 100, log=False)}*rate({h}))")
+                else:
+                    ax = r.choice(["x", "y", "z"])
+                    out.append(f"  {e} CONTROL FORCE {tip} {ax.upper()} LAW (-{num(r, 0.1, 1e6)}*{ax}({tip})-{num(r, 0.0, 100, log=False)}*v{ax}({tip}))")
             elif k == "SPRING":
                 out.append(f"  {e} SPRING 1 {tip} K {num(r, 1, 1e6)}" + (f" L0 {num(r, 0.1, 5)}" if r.random() < 0.3 else "")
                            + (" CURVE 7" if r.random() < 0.1 else ""))

@@ -292,7 +292,18 @@ class Simulation(_mecano.Simulation):
       iteration matrix is rebuilt), enter the iteration matrix, and the scheme keeps its
       order (HHT: 2).
 
-    ``sim.save(dir)`` writes a checkpoint; ``Simulation.load(dir)`` goes on from it.
+    The deck's own loads and drivers, between steps: ``set_load(k, s)`` holds the k-th
+    FORCE/MOMENT card's time function at ``s`` (the load is ``s`` times the card's
+    components, N or N·m; ``None`` gives the card its f(t) back; the accelerations restart
+    from the new load, so the scheme keeps its order across the switch);
+    ``set_drive(e, value, over=T)`` sends a driven HINGE/PRISMATIC or a PRESCRIBED
+    element ``e`` to ``value`` (rad or m) over ``T`` s along the C² quintic from its
+    present value, rate and acceleration, then holds it (a jump, ``T = 0`` while the law
+    moves or is elsewhere, is refused: a prescribed motion needs a continuous velocity).
+
+    ``sim.save(dir)`` writes a checkpoint and, beside it, ``simulation.json``: the values
+    set on loads, drivers and held inputs; ``Simulation.load(dir)`` goes on from them (a
+    record of another time than the checkpoint's is refused).
     """
 
     def run(self) -> Run:

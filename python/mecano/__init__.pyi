@@ -107,7 +107,16 @@ class Simulation:
         sensors: Optional[Sequence[Tuple[str, int]]] = None,
         tangent: str = "differentiated",
     ) -> int: ...
-    def set_input(self, input: int, value: float) -> None: ...
+    def set_input(self, input: int, value: float) -> None:
+        """A held input's value, N·m or N, from the next step on (accelerations restart)."""
+    def set_load(self, load: int, value: Optional[float]) -> None:
+        """Load ``load`` (the FORCE/MOMENT cards of LOADS from 1) is ``value`` times its
+        card's components (N or N·m) from now on, its f(t) replaced; ``None``: its f(t)
+        again. The accelerations restart from it. Starts the simulation."""
+    def set_drive(self, element: int, value: float, over: float = 0.0) -> None:
+        """A driver's value (rad or m) reached ``over`` s from now along the C² quintic
+        from its law's value, rate and acceleration, then held; ``over = 0`` only where
+        that is no jump (else ``ValueError``). Starts the simulation."""
     @property
     def t(self) -> float: ...
     @property

@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 mod deck;
 mod law;
 mod modes;
+mod overrides;
 mod poll;
 mod run;
 mod sim;

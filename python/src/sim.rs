@@ -6,6 +6,7 @@
 
 use crate::deck::{Deck, finite};
 use crate::law::PyLaw;
+use crate::overrides::{self, Overrides};
 use crate::poll::{self, Pending};
 use crate::run::{RunData, end_time};
 use crate::{MecanoError, SimulationError};
@@ -53,6 +54,8 @@ struct Inner {
     run: Option<Running>,
     /// Why the simulation cannot go on.
     failed: Option<String>,
+    /// Values set on the deck's loads and drivers.
+    overrides: Overrides,
 }
 
 /// A simulation of a deck you advance yourself (see the Python docstrings in mecano/).
@@ -200,6 +203,7 @@ impl Simulation {
                 inputs: Vec::new(),
                 run: None,
                 failed: None,
+                overrides: Overrides::default(),
             }),
             pending: Arc::new(Mutex::new(None)),
             ctrl_c: Arc::new(Mutex::new(None)),
@@ -264,16 +268,14 @@ impl Simulation {
         // Before the first step the initial accelerations were computed with the inputs'
         // `value`: recomputed with the laws' values at t = 0, so the first step starts
         // from the equations of motion it integrates (the arm held at rest by its law
-        // stays at rest). The t = 0 row already recorded keeps the former accelerations.
+        // stays at rest), and the t = 0 row is recorded again with them.
         if changed {
             let mut inner = this.lock()?;
             if let Some(r) = inner.run.as_mut()
                 && r.integ.stats.steps == 0
                 && r.integ.t == 0.0
             {
-                r.integ
-                    .consistent_accelerations()
-                    .map_err(|f| MecanoError::new_err(f.to_string()))?;
+                overrides::restart(&mut r.integ, &mut r.rec)?;
             }
         }
         Ok(())
@@ -471,17 +473,26 @@ impl Simulation {
         Ok(id)
     }
 
-    /// Sets a held input's value (N·m or N), used from the next step on.
+    /// Sets a held input's value (N·m or N), used from the next step on; in a started
+    /// dynamic run the accelerations restart from it (see set_load).
     fn set_input(&self, input: u32, value: f64) -> PyResult<()> {
         finite("value", value)?;
-        let inner = self.lock()?;
+        let mut inner = self.lock()?;
+        let inner: &mut Inner = &mut inner;
         match inner.inputs.iter().find(|i| i.id == input) {
             Some(Input {
                 held: Some(h),
                 explicit: None,
                 ..
             }) => {
+                let changed = h.get() != value;
                 h.set(value);
+                if changed
+                    && inner.failed.is_none()
+                    && let Some(r) = inner.run.as_mut()
+                {
+                    overrides::restart(&mut r.integ, &mut r.rec)?;
+                }
                 Ok(())
             }
             Some(_) => Err(PyValueError::new_err(format!(
@@ -489,6 +500,50 @@ impl Simulation {
             ))),
             None => Err(PyKeyError::new_err(format!("no input {input}"))),
         }
+    }
+
+    /// Holds load `load`'s time function at `value` from now on (the load is then
+    /// `value` times the components its card gives, N or N·m), or gives it its deck
+    /// function back (`None`). Loads are numbered from 1 in the order of the FORCE and
+    /// MOMENT cards of LOADS. A dynamic run restarts its accelerations from the new load.
+    /// Starts the simulation.
+    #[pyo3(signature = (load, value))]
+    fn set_load(slf: &Bound<'_, Self>, load: u32, value: Option<f64>) -> PyResult<()> {
+        let this = slf.get();
+        if this.in_law.load(Ordering::SeqCst) {
+            return Err(busy());
+        }
+        let mut inner = this.lock()?;
+        inner.usable()?;
+        let inner: &mut Inner = &mut inner;
+        inner.start(&this.abort)?;
+        let r = inner.run.as_mut().expect("started");
+        if inner.overrides.set_load(&mut r.integ, load, value)? {
+            overrides::restart(&mut r.integ, &mut r.rec)?;
+        }
+        Ok(())
+    }
+
+    /// Sets driver `element`'s prescribed value (rad or m; a HINGE/PRISMATIC with DRIVE,
+    /// or a PRESCRIBED): reached `over` seconds from now along the C² quintic from the
+    /// law's present value, rate and acceleration, then held at rest. `over = 0` only
+    /// where that is no jump. Starts the simulation.
+    #[pyo3(signature = (element, value, over = 0.0))]
+    fn set_drive(slf: &Bound<'_, Self>, element: u32, value: f64, over: f64) -> PyResult<()> {
+        let this = slf.get();
+        if this.in_law.load(Ordering::SeqCst) {
+            return Err(busy());
+        }
+        finite("value", value)?;
+        finite("over", over)?;
+        let mut inner = this.lock()?;
+        inner.usable()?;
+        let inner: &mut Inner = &mut inner;
+        inner.start(&this.abort)?;
+        let r = inner.run.as_mut().expect("started");
+        inner
+            .overrides
+            .set_drive(&inner.model, &mut r.integ, element, value, over)
     }
 
     /// Time reached, s.
@@ -727,8 +782,19 @@ impl Simulation {
             writer: Default::default(),
             vtk: None,
         };
+        let held: Vec<(u32, f64)> = inner
+            .inputs
+            .iter()
+            .filter(|i| i.explicit.is_none())
+            .filter_map(|i| Some((i.id, i.held.as_ref()?.get())))
+            .collect();
+        let record = inner.overrides.record(c.time, c.step, &held);
         std::fs::create_dir_all(&dir)
-            .and_then(|()| checkpoint::write(&dir, &c, 1))
+            .map_err(|e| MecanoError::new_err(format!("{}: {e}", dir.display())))?;
+        // The values set from Python first: a checkpoint left without its record would be
+        // refused at load by the record's time, never restored without them.
+        overrides::write(&dir, &record)?;
+        checkpoint::write(&dir, &c, 1)
             .map_err(|e| MecanoError::new_err(format!("{}: {e}", dir.display())))
     }
 
@@ -767,7 +833,7 @@ impl Simulation {
             deck
         };
         let sim = cls.call1((Py::new(py, deck)?,))?;
-        sim.cast::<Simulation>()?.get().restore_from(c)?;
+        sim.cast::<Simulation>()?.get().restore_from(c, &dir)?;
         Ok(sim)
     }
 
@@ -775,7 +841,7 @@ impl Simulation {
     /// simulation with inputs, add the same inputs first.
     fn restore(&self, dir: PathBuf) -> PyResult<()> {
         let c = checkpoint::read(&dir).map_err(|e| MecanoError::new_err(e.to_string()))?;
-        self.restore_from(c)
+        self.restore_from(c, &dir)
     }
 
     fn __repr__(&self) -> String {
@@ -792,7 +858,8 @@ impl Simulation {
 }
 
 impl Simulation {
-    fn restore_from(&self, c: Checkpoint) -> PyResult<()> {
+    fn restore_from(&self, c: Checkpoint, dir: &std::path::Path) -> PyResult<()> {
+        let saved = overrides::read(dir, c.time, c.step)?;
         let mut inner = self.lock()?;
         if inner.run.is_some() {
             return Err(SimulationError::new_err(
@@ -826,6 +893,24 @@ impl Simulation {
             Some(c.control),
         )
         .map_err(|e| MecanoError::new_err(e.to_string()))?;
+        if let Some(saved) = saved {
+            let inner: &mut Inner = &mut inner;
+            inner.overrides.restore(&inner.model, &mut integ, &saved)?;
+            for (id, v) in saved.inputs {
+                match inner.inputs.iter().find(|i| i.id == id) {
+                    Some(Input {
+                        held: Some(h),
+                        explicit: None,
+                        ..
+                    }) => h.set(v),
+                    _ => {
+                        return Err(SimulationError::new_err(format!(
+                            "the checkpoint was saved with input {id} held at {v}: add the same inputs (add_input), then sim.restore(dir)"
+                        )));
+                    }
+                }
+            }
+        }
         inner.run = Some(Running {
             integ,
             stepper,

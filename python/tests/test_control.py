@@ -105,9 +105,11 @@ def test_explicit_input_is_first_order(root):
         assert 0.85 < o < 1.15, (errors, orders)
 
 
-def test_deck_pid_is_the_python_pd(root):
-    """decks/pd_arm.dat's PID card and the same law from Python: the same history."""
-    deck = mecano.Deck.read(root / "decks" / "pd_arm.dat")
+@pytest.mark.parametrize("name", ["pd_arm.dat", "pd_arm_law.dat"])
+def test_deck_pid_is_the_python_pd(root, name):
+    """decks/pd_arm.dat's PID card, and decks/pd_arm_law.dat's CONTROL law of sensors,
+    against the same law from Python: the same history."""
+    deck = mecano.Deck.read(root / "decks" / name)
     run = mecano.run(deck)
     sim = mecano.Simulation(arm(root, 1e-3))
     sim.add_input(
@@ -122,6 +124,7 @@ def test_deck_pid_is_the_python_pd(root):
     # Same equations and scheme; the Python law's tangent is a forward difference (1e-7
     # relative), so Newton stops at slightly different iterates: within its tolerance.
     assert np.max(np.abs(a - b)) < 1e-9
+    # HHT alpha = 0 at h = 1e-3 s: 5.7e-8 rad from the ODE at 1 s (docs/python.md).
     assert abs(run.element(3)["s1"][-1] - reference()) < 2e-5
 
 
@@ -320,3 +323,6 @@ def test_an_explicit_law_sets_the_initial_accelerations(root):
     sim.add_input(hinge=1, law=lambda t, sim: 9.81, tangent="explicit")
     sim.advance(0.1)
     assert abs(sim.joint_angle(1)) < 1e-12
+    # The first row, recorded again once the law's value set the start: at rest, no
+    # acceleration (it showed the free fall's -9.81 m/s^2 before).
+    assert np.max(np.abs(sim.run().node(2)["ay"])) < 1e-12

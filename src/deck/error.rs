@@ -406,12 +406,15 @@ pub enum DeckErrorKind {
         /// Why that is refused.
         reason: &'static str,
     },
-    /// An RSPRING naming an element that is not a HINGE.
-    #[error(
-        "RSPRING element {element} names element {target}, a {found}: an RSPRING acts on a HINGE"
-    )]
+    /// An RSPRING, PID or CONTROL (its actuator or a sensor) naming an element that is
+    /// not a HINGE.
+    #[error("{by} element {element} names element {target}, a {found}: {what} a HINGE")]
     NotAHinge {
-        /// The RSPRING.
+        /// The referring element's type keyword (`RSPRING`, `PID`, `CONTROL`).
+        by: &'static str,
+        /// What it needs the hinge for.
+        what: &'static str,
+        /// The referring element.
         element: u32,
         /// The element it names.
         target: u32,

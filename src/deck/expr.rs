@@ -58,6 +58,7 @@ pub(crate) enum ExprErrorKind {
 /// recursive descent stays well inside a thread's stack (a few hundred bytes per level).
 pub const MAX_DEPTH: usize = 100;
 
+use crate::model::control::Sensor;
 use crate::model::{At, BinOp, Expr, Func};
 
 /// Whether a field's text is meant as an expression (rather than a keyword or a malformed
@@ -94,12 +95,40 @@ pub(crate) fn parse_time(
 }
 
 fn parse(text: &str, lookup: &dyn Fn(&str) -> Option<f64>, time: bool) -> Result<Node, ExprError> {
+    parse_with(text, lookup, time, None)
+}
+
+/// A sensor an expression reads, where it is in the text (the reference it names is
+/// checked by the card's builder).
+pub(crate) type SensorRef = (Sensor, At);
+
+/// Reads `text` as a control law (`ELEMENTS … CONTROL … LAW`): an expression of the time
+/// `t` and of sensors — `angle(h)`, `rate(h)` of a HINGE `h`, `x(n)`, `y(n)`, `z(n)`,
+/// `vx(n)`, `vy(n)`, `vz(n)` of a node `n`, each argument a constant whole number
+/// (`$name` allowed). Returns the tree, whose [`Expr::Sensor`] indices number the
+/// distinct sensors in order of first appearance, and those sensors.
+pub(crate) fn parse_law(
+    text: &str,
+    lookup: &dyn Fn(&str) -> Option<f64>,
+) -> Result<(Expr, Vec<SensorRef>), ExprError> {
+    let mut sensors = Vec::new();
+    let node = parse_with(text, lookup, true, Some(&mut sensors))?;
+    Ok((node.e, sensors))
+}
+
+fn parse_with(
+    text: &str,
+    lookup: &dyn Fn(&str) -> Option<f64>,
+    time: bool,
+    sensors: Option<&mut Vec<SensorRef>>,
+) -> Result<Node, ExprError> {
     let mut p = Parser {
         s: text.as_bytes(),
         pos: 0,
         depth: 0,
         lookup,
         time,
+        sensors,
     };
     let node = p.expr()?;
     p.blanks();
@@ -108,6 +137,26 @@ fn parse(text: &str, lookup: &dyn Fn(&str) -> Option<f64>, time: bool) -> Result
     }
     Ok(node)
 }
+
+/// The sensor a name reads, with the number it takes: `angle`, `rate` (a HINGE's),
+/// `x`, `y`, `z`, `vx`, `vy`, `vz` (a node's).
+fn sensor_of(name: &str, id: u32) -> Option<Sensor> {
+    use crate::model::{ElementId, NodeId};
+    Some(match name {
+        "angle" => Sensor::HingeAngle(ElementId(id)),
+        "rate" => Sensor::HingeRate(ElementId(id)),
+        "x" => Sensor::Coordinate(NodeId(id), 0),
+        "y" => Sensor::Coordinate(NodeId(id), 1),
+        "z" => Sensor::Coordinate(NodeId(id), 2),
+        "vx" => Sensor::Velocity(NodeId(id), 0),
+        "vy" => Sensor::Velocity(NodeId(id), 1),
+        "vz" => Sensor::Velocity(NodeId(id), 2),
+        _ => return None,
+    })
+}
+
+/// The sensors' names, for messages.
+pub(crate) const SENSORS: &str = "angle(h), rate(h), x(n), y(n), z(n), vx(n), vy(n), vz(n)";
 
 /// A subexpression read: its tree and, when it does not depend on `t`, its value.
 struct Node {
@@ -149,9 +198,60 @@ struct Parser<'s, 'f> {
     lookup: &'f dyn Fn(&str) -> Option<f64>,
     /// Whether `t` is the time variable (an EXPR function) or an unknown name.
     time: bool,
+    /// A control law's sensors read so far (`None`: sensors are unknown names).
+    sensors: Option<&'f mut Vec<SensorRef>>,
 }
 
 impl Parser<'_, '_> {
+    /// `name(<whole number>)` of a sensor, after its name (`start`: where it began).
+    fn sensor(&mut self, name: &str, start: usize) -> Result<Node, ExprError> {
+        if self.peek() != Some(b'(') {
+            return Err(self.syntax(&format!("`(` and a number after the sensor {name}")));
+        }
+        self.pos += 1;
+        let arg_start = self.pos;
+        let arg = self.expr()?;
+        let arg_end = self.pos;
+        self.close()?;
+        let id = match arg.v {
+            Some(v) if v >= 1.0 && v <= f64::from(u32::MAX) && v.fract() == 0.0 => v as u32,
+            _ => {
+                return Err(ExprError {
+                    at: arg_start,
+                    len: arg_end - arg_start,
+                    kind: ExprErrorKind::Syntax {
+                        expected: format!(
+                            "a whole number >= 1 (the {} number) as the argument of {name}",
+                            if matches!(name, "angle" | "rate") {
+                                "HINGE element"
+                            } else {
+                                "node"
+                            }
+                        ),
+                        found: format!(
+                            "`{}`",
+                            std::str::from_utf8(&self.s[arg_start..arg_end]).unwrap_or("?")
+                        ),
+                    },
+                });
+            }
+        };
+        let sensor = sensor_of(name, id).expect("a sensor's name");
+        let at = At::span(start, self.pos);
+        let list = self.sensors.as_mut().expect("sensors are read in a law");
+        let k = match list.iter().position(|(s, _)| *s == sensor) {
+            Some(k) => k,
+            None => {
+                list.push((sensor, at));
+                list.len() - 1
+            }
+        };
+        Ok(Node {
+            e: Expr::Sensor(k, at),
+            v: None,
+        })
+    }
+
     fn blanks(&mut self) {
         while self.pos < self.s.len() && self.s[self.pos].is_ascii_whitespace() {
             self.pos += 1;
@@ -335,6 +435,9 @@ impl Parser<'_, '_> {
                         e: Expr::Time,
                         v: None,
                     });
+                }
+                if self.sensors.is_some() && sensor_of(&name, 1).is_some() {
+                    return self.sensor(&name, start);
                 }
                 let len = self.pos - start;
                 let Some(func) = Func::from_name(&name) else {

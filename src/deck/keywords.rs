@@ -179,9 +179,21 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     ),
     kw("TRANS", "NODES", "the three translations"),
     kw("ROT", "NODES", "the three rotations"),
-    kw("X", "NODES", "translation along global X"),
-    kw("Y", "NODES", "translation along global Y"),
-    kw("Z", "NODES", "translation along global Z"),
+    kw(
+        "X",
+        "NODES",
+        "translation along global X (also PRESCRIBED's and CONTROL FORCE's direction)",
+    ),
+    kw(
+        "Y",
+        "NODES",
+        "translation along global Y (also PRESCRIBED's and CONTROL FORCE's direction)",
+    ),
+    kw(
+        "Z",
+        "NODES",
+        "translation along global Z (also PRESCRIBED's and CONTROL FORCE's direction)",
+    ),
     kw("RX", "NODES", "rotation about global X"),
     kw("RY", "NODES", "rotation about global Y"),
     kw("RZ", "NODES", "rotation about global Z"),
@@ -384,6 +396,16 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "PID: function number of the target angle f(t) (exact derivatives; AMPLITUDE a scales it)",
     ),
     kw(
+        "CONTROL",
+        "ELEMENTS",
+        "controlled input: a torque on a HINGE (TORQUE) or a force on a node (FORCE) whose LAW is an expression of t and sensors",
+    ),
+    kw(
+        "TORQUE",
+        "ELEMENTS",
+        "CONTROL: the input is a torque about the axis of the HINGE element that follows, N·m",
+    ),
+    kw(
         "CLEARANCE",
         "ELEMENTS",
         "revolute joint with radial clearance (element type; and its clearance, m)",
@@ -392,7 +414,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "LAW",
         "ELEMENTS",
-        "CLEARANCE: the normal force law (KV or LN)",
+        "CLEARANCE: the normal force law (KV or LN); CONTROL: the input's value, an expression of t and sensors",
     ),
     kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
     kw(
@@ -457,7 +479,11 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     ),
     // loads
     kw("GRAVITY", "LOADS", "gravity acceleration vector, m/s²"),
-    kw("FORCE", "LOADS", "nodal force, N, global frame"),
+    kw(
+        "FORCE",
+        "LOADS",
+        "nodal force, N, global frame (also ELEMENTS CONTROL FORCE: a controlled force)",
+    ),
     kw("MOMENT", "LOADS", "nodal moment, N·m, global frame"),
     kw(
         "FUNCTION",

@@ -12,7 +12,7 @@
 mod build;
 mod cards;
 mod error;
-mod expr;
+pub(crate) mod expr;
 mod keywords;
 mod lex;
 pub mod limits;
@@ -123,8 +123,14 @@ pub fn strip_spans(model: &mut Model) {
     model.initial.iter_mut().for_each(|x| x.span = zero);
     model.drives.values_mut().for_each(|x| x.span = zero);
     for e in model.elements.values_mut() {
-        if let crate::model::ElementKind::Prescribed { drive, .. } = &mut e.kind {
-            drive.span = zero;
+        match &mut e.kind {
+            crate::model::ElementKind::Prescribed { drive, .. } => drive.span = zero,
+            crate::model::ElementKind::Control(c) => {
+                if let crate::model::control::ControlLaw::Expr(law) = &mut c.law {
+                    law.field = zero;
+                }
+            }
+            _ => {}
         }
     }
 }

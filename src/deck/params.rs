@@ -76,6 +76,27 @@ pub(crate) fn time_expression(
         .map_err(|e| located(tok, e, || known(params.keys())))
 }
 
+/// The field `tok` read as a control law (`ELEMENTS … CONTROL … LAW`): an expression of
+/// `t` and of sensors, with the parameters' values in force; errors located inside the
+/// field (a name that is neither a function nor a sensor names both lists).
+pub(crate) fn law_expression(
+    tok: &Token<'_>,
+    params: &IndexMap<String, f64>,
+) -> Result<(crate::model::Expr, Vec<expr::SensorRef>), DeckError> {
+    expr::parse_law(tok.text, &|n| params.get(n).copied()).map_err(|mut e| {
+        if let ExprErrorKind::UnknownFunction { name } = &e.kind {
+            e.kind = ExprErrorKind::Syntax {
+                expected: format!(
+                    "a sensor ({}) or a function (sqrt, sin, cos, exp, log, abs)",
+                    expr::SENSORS
+                ),
+                found: format!("`{name}`"),
+            };
+        }
+        located(tok, e, || known(params.keys()))
+    })
+}
+
 /// The value of a field: its number, or its expression evaluated with `params`.
 fn value(tok: &Token<'_>, params: &IndexMap<String, (f64, Span)>) -> Result<f64, DeckError> {
     if let Some(v) = tok.number {

@@ -4,6 +4,7 @@
 //! generated nodes and elements are written one per line; every analysis setting is
 //! written explicitly.
 
+use crate::model::control::ControlLaw;
 use crate::model::{
     Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
     Scheme, Section, SectionData, Selection, SpringLength,
@@ -203,9 +204,16 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 None => match &e.kind {
                     ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
-                    ElementKind::Control(c) => match c.actuator {
-                        crate::model::control::Actuator::HingeTorque(h) => vec![h.0.to_string()],
-                        crate::model::control::Actuator::NodeForce(n, _) => vec![n.0.to_string()],
+                    ElementKind::Control(c) => match (c.actuator, &c.law) {
+                        (crate::model::control::Actuator::HingeTorque(h), ControlLaw::Pid(_)) => {
+                            vec![h.0.to_string()]
+                        }
+                        (crate::model::control::Actuator::HingeTorque(h), _) => {
+                            vec![format!("TORQUE {}", h.0)]
+                        }
+                        (crate::model::control::Actuator::NodeForce(n, a), _) => {
+                            vec![format!("FORCE {} {}", n.0, ["X", "Y", "Z"][a.min(2)])]
+                        }
                     },
                     _ => e.nodes.iter().map(|n| n.0.to_string()).collect(),
                 },
@@ -300,15 +308,19 @@ pub fn write_deck(model: &Model) -> String {
                         let _ = write!(s, " AXES {} {}", col(0), col(1));
                     }
                 }
-                ElementKind::Control(c) => {
-                    if let crate::model::control::ControlLaw::Pid(p) = &c.law {
+                ElementKind::Control(c) => match &c.law {
+                    ControlLaw::Pid(p) => {
                         let _ = write!(
                             s,
                             " KP {:?} KI {:?} KD {:?} TARGET {} AMPLITUDE {:?}",
                             p.kp, p.ki, p.kd, p.target.0, p.amplitude
                         );
                     }
-                }
+                    ControlLaw::Expr(e) => {
+                        let _ = write!(s, " LAW {}", e.text);
+                    }
+                    _ => {}
+                },
                 ElementKind::RSpring(r) => {
                     let _ = write!(
                         s,

@@ -25,6 +25,10 @@
 //! that the stages of the ESDIRK schemes integrate from the step's start too):
 //! `∂u/∂θ = −k_p − ½ k_i (t − t_n)`, `∂u/∂θ̇ = −k_d`.
 //!
+//! # A deck's law (`CONTROL … LAW`)
+//! `u(t, s)` an expression of the time and the sensors (`model::Expr`), its derivatives
+//! `∂u/∂sₖ` exact by forward-mode jets, one pass per sensor ([`crate::model::Expr::law`]).
+//!
 //! # Work
 //! The input's power `u ḋ` (`u θ̇`, `u v_a`) counts as external work in the energy balance
 //! ([`Element::input_power`]), so the energy guard pays for what a controller puts in.
@@ -68,6 +72,7 @@ enum Resolved {
         target: TimeLaw,
     },
     External(Arc<dyn Law>),
+    Expr(crate::model::Expr),
 }
 
 /// The controlled input element (see the module docs).
@@ -81,6 +86,8 @@ pub struct Control {
     angles: Vec<f64>,
     /// PID: `I_n`, `e_n`, `t_n` at the last accepted state.
     pid: [f64; 3],
+    /// Time of the last accepted state, s (for a diagnosis).
+    t_last: f64,
 }
 
 impl std::fmt::Debug for Control {
@@ -233,6 +240,7 @@ impl Control {
         let law = match &data.law {
             ControlLaw::Held(v) => Resolved::Held(v.clone()),
             ControlLaw::External(l) => Resolved::External(l.clone()),
+            ControlLaw::Expr(e) => Resolved::Expr(e.expr.clone()),
             ControlLaw::Pid(p) => {
                 if !matches!(
                     data.sensors.as_slice(),
@@ -262,6 +270,7 @@ impl Control {
             law,
             angles: vec![0.0; n_angles],
             pid: [0.0; 3],
+            t_last: 0.0,
         })
     }
 
@@ -326,6 +335,7 @@ impl Control {
                 kp * e + ki * (i_n + 0.5 * dt * (e_n + e)) + kd * ed
             }
             Resolved::External(l) => l.eval(t, s, grad),
+            Resolved::Expr(e) => e.law(t, s, grad),
         }
     }
 
@@ -427,6 +437,7 @@ impl Element for Control {
     }
 
     fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {
+        self.t_last = ctx.t;
         let s = self.values(nodes);
         if let Resolved::Pid { target, .. } = &self.law
             && let Some(s) = &s
@@ -506,9 +517,20 @@ impl Element for Control {
     }
 
     fn diagnose(&self, nodes: &[NodeState]) -> Option<String> {
-        self.values(nodes).is_none().then(|| {
-            format!(
+        let Some(s) = self.values(nodes) else {
+            return Some(format!(
                 "{} (controlled input): a hinge it reads has no angle about its axis (torn apart)",
+                self.id
+            ));
+        };
+        // The law at the state, at the last accepted time (the step's own time is not
+        // known here): a law that is not finite there names its sensors' values.
+        let t = self.t_last;
+        let mut grad = vec![0.0; s.len()];
+        let u = self.law(t, &s, Some(&mut grad));
+        (!u.is_finite() || grad.iter().any(|g| !g.is_finite())).then(|| {
+            format!(
+                "{} (controlled input): its law is not finite at this state (value {u}, derivatives {grad:?} with the sensors s = {s:?}, t = {t} s)",
                 self.id
             )
         })

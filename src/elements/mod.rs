@@ -476,6 +476,12 @@ pub trait Element: Send + Sync {
         0.0
     }
 
+    /// A driver's time law (a driven HINGE/PRISMATIC, a PRESCRIBED), for a program that
+    /// sets its value between steps ([`drive::TimeLaw::set_value`]). Default: none.
+    fn drive_law_mut(&mut self) -> Option<&mut drive::TimeLaw> {
+        None
+    }
+
     /// Whether the last [`Element::commit`] switched the element's force law
     /// discontinuously (a contact's dashpot acting from a touch event on): the integrator
     /// then recomputes consistent accelerations at the committed state, as at `t = 0`,

@@ -137,6 +137,10 @@ impl Element for Prescribed {
         self.id
     }
 
+    fn drive_law_mut(&mut self) -> Option<&mut TimeLaw> {
+        Some(&mut self.law)
+    }
+
     fn nodes(&self) -> &[usize] {
         &self.nodes
     }

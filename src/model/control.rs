@@ -92,6 +92,10 @@ pub enum ControlLaw {
     Pid(Pid),
     /// An external law evaluated at every iterate with its derivatives ([`Law`]).
     External(Arc<dyn Law>),
+    /// The deck's `CONTROL … LAW <expression>`: an expression of `t` and of the sensors
+    /// (its [`super::Expr::Sensor`] `k` is `sensors[k]`), evaluated at every iterate with
+    /// its exact derivatives with respect to the sensors ([`super::Expr::law`]).
+    Expr(super::TimeExpr),
 }
 
 impl std::fmt::Debug for ControlLaw {
@@ -100,6 +104,7 @@ impl std::fmt::Debug for ControlLaw {
             ControlLaw::Held(v) => write!(f, "Held({})", v.get()),
             ControlLaw::Pid(p) => write!(f, "{p:?}"),
             ControlLaw::External(_) => write!(f, "External"),
+            ControlLaw::Expr(e) => write!(f, "Expr({})", e.text),
         }
     }
 }
@@ -110,6 +115,7 @@ impl PartialEq for ControlLaw {
             (ControlLaw::Held(a), ControlLaw::Held(b)) => Arc::ptr_eq(a, b),
             (ControlLaw::Pid(a), ControlLaw::Pid(b)) => a == b,
             (ControlLaw::External(a), ControlLaw::External(b)) => Arc::ptr_eq(a, b),
+            (ControlLaw::Expr(a), ControlLaw::Expr(b)) => a == b,
             _ => false,
         }
     }

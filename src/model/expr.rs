@@ -154,6 +154,9 @@ pub enum Expr {
     },
     /// The time `t`.
     Time,
+    /// The value of the law's sensor number `k` (a `CONTROL` card's `angle(3)`, `vx(5)`:
+    /// [`crate::model::control::ControlData::sensors`]); only in a control law.
+    Sensor(usize, At),
     /// `-x`.
     Neg(Box<Expr>, At),
     /// `a op b`.
@@ -165,19 +168,59 @@ pub enum Expr {
 impl Expr {
     /// Value and exact first and second derivatives with respect to `t`, at `t`.
     pub fn jet(&self, t: f64) -> Jet2 {
+        self.jet_at(t, &[], None)
+    }
+
+    /// Value and exact derivatives at `t` and sensor values `s`, with respect to `t`
+    /// (`wrt = None`) or to the sensor `s[k]` (`wrt = Some(k)`). A sensor beyond `s` is
+    /// NaN (a time function has none).
+    pub fn jet_at(&self, t: f64, s: &[f64], wrt: Option<usize>) -> Jet2 {
         match self {
             Expr::Num(v) | Expr::Param { value: v, .. } => Jet2::constant(*v),
-            Expr::Time => Jet2::variable(t),
-            Expr::Neg(x, _) => -x.jet(t),
-            Expr::Bin(op, a, b, _) => op.apply_jet(a.jet(t), b.jet(t)),
-            Expr::Call(f, x, _) => f.apply_jet(x.jet(t)),
+            Expr::Time if wrt.is_none() => Jet2::variable(t),
+            Expr::Time => Jet2::constant(t),
+            Expr::Sensor(k, _) => {
+                let v = s.get(*k).copied().unwrap_or(f64::NAN);
+                if wrt == Some(*k) {
+                    Jet2::variable(v)
+                } else {
+                    Jet2::constant(v)
+                }
+            }
+            Expr::Neg(x, _) => -x.jet_at(t, s, wrt),
+            Expr::Bin(op, a, b, _) => op.apply_jet(a.jet_at(t, s, wrt), b.jet_at(t, s, wrt)),
+            Expr::Call(f, x, _) => f.apply_jet(x.jet_at(t, s, wrt)),
+        }
+    }
+
+    /// A control law's value `u(t, s)` and, into `grad`, its exact derivatives `∂u/∂sₖ`
+    /// (forward mode, one pass per sensor: `Jet2`'s first component).
+    pub fn law(&self, t: f64, s: &[f64], grad: Option<&mut [f64]>) -> f64 {
+        if let Some(g) = grad {
+            for (k, gk) in g.iter_mut().enumerate() {
+                *gk = self.jet_at(t, s, Some(k)).d1;
+            }
+        }
+        self.jet_at(t, s, Some(usize::MAX)).v
+    }
+
+    /// The expression with every sensor replaced by the number `s[k]` (an expression of
+    /// `t` alone, which [`Expr::prove_finite`] can check).
+    pub fn with_sensors(&self, s: &[f64]) -> Expr {
+        let b = |e: &Expr| Box::new(e.with_sensors(s));
+        match self {
+            Expr::Sensor(k, _) => Expr::Num(s.get(*k).copied().unwrap_or(f64::NAN)),
+            Expr::Neg(x, at) => Expr::Neg(b(x), *at),
+            Expr::Bin(op, x, y, at) => Expr::Bin(*op, b(x), b(y), *at),
+            Expr::Call(f, x, at) => Expr::Call(*f, b(x), *at),
+            other => other.clone(),
         }
     }
 
     /// Whether `t` appears in the expression.
     pub fn depends_on_time(&self) -> bool {
         match self {
-            Expr::Num(_) | Expr::Param { .. } => false,
+            Expr::Num(_) | Expr::Param { .. } | Expr::Sensor(..) => false,
             Expr::Time => true,
             Expr::Neg(x, _) | Expr::Call(_, x, _) => x.depends_on_time(),
             Expr::Bin(_, a, b, _) => a.depends_on_time() || b.depends_on_time(),

@@ -127,6 +127,27 @@ impl Recorder {
         self.energy.data.extend_from_slice(&row);
     }
 
+    /// Records the initial state again in place of the row written at `t = 0`, when no
+    /// step was taken since: a program that set an input's value (or a load's) before the
+    /// first step recomputed the initial accelerations with it, and the first row shows
+    /// the state the run starts from. Returns whether it did.
+    pub fn record_start_again(&mut self, integ: &Integrator) -> bool {
+        if integ.stats.steps != 0 || self.last_row != Some(0) {
+            return false;
+        }
+        for r in self
+            .nodes
+            .iter_mut()
+            .chain(&mut self.elements)
+            .chain(std::iter::once(&mut self.energy))
+        {
+            r.data.clear();
+        }
+        self.balance = Balance::default();
+        self.record(integ);
+        true
+    }
+
     /// Closes the histories as [`super::Writer::finish`] closes the files (the final state
     /// recorded if `EVERY` skipped it and the run was not interrupted) and returns the
     /// content of `summary.json`.

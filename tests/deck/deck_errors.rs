@@ -424,6 +424,43 @@ fn malformed_decks_table() {
         (format!("{A}END now\n"), 2, 5, "unexpected `now`"),
         (format!("TITLE é\nNODES\n 1 é 0 0\n{A}"), 3, 4, "found `é`"),
         (format!("NODES\n 1 0 0 &\n   zz\n{A}"), 3, 4, "found `zz`"),
+        // CONTROL laws (issue 36 §6): sensors checked and located inside the law's field
+        (
+            el(" 1 HINGE 1 2 AXIS 0 0 1\n 2 CONTROL TORQUE 1 LAW (-4*angel(1))"),
+            10,
+            29,
+            "a sensor (angle(h), rate(h)",
+        ),
+        (
+            el(" 1 HINGE 1 2 AXIS 0 0 1\n 2 MASS 2 M 1\n 3 CONTROL TORQUE 1 LAW (-4*rate(2))"),
+            11,
+            29,
+            "CONTROL element 3 names element 2, a MASS",
+        ),
+        (
+            el(" 1 HINGE 1 2 AXIS 0 0 1\n 2 CONTROL FORCE 2 X LAW -4*vx(9)"),
+            10,
+            29,
+            "undefined node 9",
+        ),
+        (
+            el(" 1 HINGE 1 2 AXIS 0 0 1\n 2 CONTROL TORQUE 1 LAW (1+1/angle(1))"),
+            10,
+            28,
+            "`1/angle(1)` in `(1+1/angle(1))`: its value is not finite at t = 0 s",
+        ),
+        (
+            el(" 1 HINGE 1 2 AXIS 0 0 1\n 2 CONTROL TORQUE 1 LAW (-angle(1.5))"),
+            10,
+            33,
+            "a whole number >= 1",
+        ),
+        (
+            el(" 1 HINGE 1 2 AXIS 0 0 1\n 2 CONTROL TORQUE 1"),
+            10,
+            20,
+            "LAW",
+        ),
     ];
     assert!(cases.len() >= 30);
     let mut failures = Vec::new();

@@ -1,4 +1,4 @@
-//! Integration tests of the mechanics (dynamics, springs, drivers, contact, clearance,
+//! Integration tests of the mechanics (dynamics, springs, drivers, contact, clearance, control,
 //! rotations, sparse modes), in one test binary (one link instead of seven): each module is
 //! a former `tests/<name>.rs`; `cargo test --test mechanics <name>::` runs one of them.
 //!
@@ -11,6 +11,7 @@ mod common;
 
 mod clearance;
 mod contact;
+mod control;
 mod drivers;
 mod dynamics;
 mod modes_sparse;

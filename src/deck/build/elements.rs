@@ -36,7 +36,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 15] = [
+        const TYPES: [&str; 16] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -50,6 +50,7 @@ impl Builder<'_> {
             "BUSHING",
             "RSPRING",
             "PID",
+            "CONTROL",
             "PRESCRIBED",
             "CLEARANCE",
         ];
@@ -254,6 +255,7 @@ impl Builder<'_> {
             "BUSHING" => Self::bushing_card(&mut c)?,
             "RSPRING" => self.rspring_card(&mut c, id)?,
             "PID" => self.pid_card(&mut c, id)?,
+            "CONTROL" => self.control_card(&mut c, id)?,
             "PRESCRIBED" => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)

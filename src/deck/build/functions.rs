@@ -245,6 +245,8 @@ fn drive_jumps(id: u32, f: &Function, end: f64, at: Span) -> Option<DeckError> {
 enum Use {
     Time,
     Deflection,
+    /// A CONTROL law, its sensors at the drawing at rest.
+    Law,
 }
 
 /// `t` rounded to 9 significant digits (what a message shows).
@@ -268,10 +270,16 @@ fn not_finite(
     let (var, unit) = match role {
         Use::Time => ("t", "s"),
         Use::Deflection => ("the deflection", "m"),
+        Use::Law => ("t", "s"),
     };
     let at = shown(b.point.unwrap_or(0.5 * b.piece.0 + 0.5 * b.piece.1));
     DeckError::new(
         K::FunctionNotFinite(Box::new(crate::deck::error::FunctionNotFinite {
+            owner: if matches!(role, Use::Law) {
+                "CONTROL element (its sensors at the deck's drawing, at rest)"
+            } else {
+                "function"
+            },
             id,
             text: e.text.clone(),
             part,
@@ -284,6 +292,17 @@ fn not_finite(
         })),
         span,
     )
+}
+
+/// The located error of a `CONTROL` law not shown finite on `[0, END]` with its sensors
+/// at their initial values (`deck/build/control.rs`).
+pub(super) fn law_not_finite(
+    id: u32,
+    e: &TimeExpr,
+    domain: (f64, f64),
+    b: &crate::model::Blowup,
+) -> DeckError {
+    not_finite(id, e, Use::Law, domain, b)
 }
 
 /// The numbers up to the end of the card or the keyword `stop`, with their spans.

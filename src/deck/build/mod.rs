@@ -257,6 +257,7 @@ pub(crate) fn build_model(
         return Err(b.errors);
     };
     b.check_functions(&analysis);
+    b.check_controls(&analysis);
     if !b.errors.is_empty() {
         return Err(b.errors);
     }

@@ -191,6 +191,17 @@ impl Builder<'_> {
                 Some(h) => match &h.kind {
                     ElementKind::Hinge { axis, .. } => Ok((h.nodes.clone(), *axis)),
                     other => Err(K::NotAHinge {
+                        by: self
+                            .elements
+                            .get(&id)
+                            .map_or("RSPRING", |e| e.kind.keyword()),
+                        what: match self.elements.get(&id).map(|e| e.kind.keyword()) {
+                            Some("CONTROL") => {
+                                "its TORQUE acts on, and its angle(h) and rate(h) read,"
+                            }
+                            Some("PID") => "a PID acts on",
+                            _ => "an RSPRING acts on",
+                        },
                         element: id.0,
                         target: hinge,
                         found: other.keyword(),
@@ -206,12 +217,31 @@ impl Builder<'_> {
                                 d.axis = axis;
                                 el.nodes = nodes;
                             }
-                            // A PID's torque acts on its hinge's nodes (deck/build/control.rs).
-                            ElementKind::Control(_) => el.nodes = nodes,
                             _ => {}
                         }
                     }
                 }
+            }
+        }
+        // A PID's or CONTROL's input acts on its actuator's and sensors' nodes (a hinge's
+        // two), once all hinges are known (deck/build/control.rs).
+        let hinge_nodes = |h: ElementId| match self.elements.get(&h) {
+            Some(e) if matches!(e.kind, ElementKind::Hinge { .. }) => {
+                Some([e.nodes[0], e.nodes[1]])
+            }
+            _ => None,
+        };
+        let nodes: Vec<(ElementId, Vec<NodeId>)> = self
+            .elements
+            .iter()
+            .filter_map(|(id, e)| match &e.kind {
+                ElementKind::Control(d) => Some((*id, d.nodes(hinge_nodes))),
+                _ => None,
+            })
+            .collect();
+        for (id, n) in nodes {
+            if let Some(el) = self.elements.get_mut(&id) {
+                el.nodes = n;
             }
         }
     }

@@ -6,7 +6,9 @@ use std::fmt;
 /// Where an EXPR function could not be shown finite ([`super::DeckErrorKind::FunctionNotFinite`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FunctionNotFinite {
-    /// The function's number.
+    /// What it is: `function`, or `CONTROL element` (a law, its sensors at the drawing).
+    pub owner: &'static str,
+    /// The function's (element's) number.
     pub id: u32,
     /// The expression.
     pub text: String,
@@ -29,6 +31,7 @@ pub struct FunctionNotFinite {
 impl fmt::Display for FunctionNotFinite {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let FunctionNotFinite {
+            owner,
             id,
             text,
             part,
@@ -46,7 +49,7 @@ impl fmt::Display for FunctionNotFinite {
         };
         write!(
             f,
-            "function {id}: `{part}` in `{text}`: its {what} {how} at {var} = {at} {unit} ({var} in [{}, {}] {unit} is the domain the run can reach; shown by interval arithmetic, which bounds the expression at every double of it)",
+            "{owner} {id}: `{part}` in `{text}`: its {what} {how} at {var} = {at} {unit} ({var} in [{}, {}] {unit} is the domain the run can reach; shown by interval arithmetic, which bounds the expression at every double of it)",
             domain.0, domain.1
         )
     }

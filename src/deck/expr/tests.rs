@@ -279,3 +279,36 @@ fn enclosures_hold_the_pointwise_jets() {
         }
     }
 }
+
+/// A control law's sensors: each distinct sensor once (in order of first appearance, the
+/// index its tree nodes carry), names case-insensitive, the argument a constant whole
+/// number (`$name` allowed); outside a law a sensor's name is an unknown function.
+#[test]
+fn law_sensors_are_numbered_once_and_checked() {
+    use crate::model::control::Sensor;
+    use crate::model::{ElementId, NodeId};
+    let (e, s) = parse_law("-$k*(ANGLE(3)-t)-rate(3)+angle(3)*vz(2*$k)", &params).unwrap();
+    let sensors: Vec<Sensor> = s.iter().map(|r| r.0).collect();
+    assert_eq!(
+        sensors,
+        [
+            Sensor::HingeAngle(ElementId(3)),
+            Sensor::HingeRate(ElementId(3)),
+            Sensor::Velocity(NodeId(8), 2),
+        ]
+    );
+    // u = -4 (a - t) - r + a vz: ∂u/∂a = -4 + vz, ∂u/∂r = -1, ∂u/∂vz = a.
+    let mut g = [0.0; 3];
+    let u = e.law(0.5, &[0.2, 1.5, -3.0], Some(&mut g));
+    assert_eq!(u, -4.0 * (0.2 - 0.5) - 1.5 + 0.2 * -3.0);
+    assert_eq!(g, [-4.0 - 3.0, -1.0, 0.2]);
+    for (text, at) in [("angle(0)", 6), ("x(1.5)", 2), ("rate(t)", 5), ("vx 3", 3)] {
+        let err = parse_law(text, &params).unwrap_err();
+        assert_eq!(err.at, at, "{text}: {err:?}");
+    }
+    let err = parse_time("angle(1)", &params).unwrap_err();
+    assert!(
+        matches!(err.kind, ExprErrorKind::UnknownFunction { .. }),
+        "{err:?}"
+    );
+}

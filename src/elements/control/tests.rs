@@ -195,3 +195,53 @@ fn bad_references_are_refused() {
         Err(E::Axis(3))
     );
 }
+
+/// The deck's law of sensors (`CONTROL … LAW`): the same smooth law as [`Smooth`] written
+/// as an expression gives the same value, its jets' gradient the hand-written one (to
+/// round-off), and the element's iteration matrix passes the central differences of its
+/// residual on every kind of sensor.
+#[test]
+fn expression_law_is_exact_and_its_tangent_matches_finite_differences() {
+    let (expr, refs) =
+        crate::deck::expr::parse_law("3*angle(1)+rate(1)^2+sin(y(2))-1.5*t*vx(2)", &|_| None)
+            .expect("parses");
+    let sensors: Vec<Sensor> = refs.iter().map(|r| r.0).collect();
+    assert_eq!(sensors, all_sensors());
+    for (t, s) in [(0.3, [0.2, -1.1, 0.7, 2.0]), (2.0, [-3.0, 0.5, -0.2, -0.4])] {
+        let (mut g, mut want) = ([0.0; 4], [0.0; 4]);
+        let u = expr.law(t, &s, Some(&mut g));
+        let v = Smooth.eval(t, &s, Some(&mut want));
+        assert!((u - v).abs() <= 1e-14 * v.abs().max(1.0), "{u} {v}");
+        for k in 0..4 {
+            assert!(
+                (g[k] - want[k]).abs() <= 1e-14 * want[k].abs().max(1.0),
+                "{k}"
+            );
+        }
+    }
+    let law = crate::model::TimeExpr {
+        text: String::new(),
+        expr,
+        field: Default::default(),
+    };
+    for actuator in [
+        Actuator::HingeTorque(ElementId(1)),
+        Actuator::NodeForce(crate::model::NodeId(2), 1),
+    ] {
+        let (m, c) = model_with(
+            PENDULUM,
+            ControlData {
+                actuator,
+                sensors: sensors.clone(),
+                law: ControlLaw::Expr(law.clone()),
+            },
+        );
+        let x0: Vec<_> = m.nodes.values().map(|n| n.position).collect();
+        for seed in 1..4 {
+            let st = random_states(&x0, 0.1, 0.5, seed);
+            let mut ctx = dyn_ctx();
+            ctx.t = 0.3;
+            check_tangent(&c, &ctx, &st, &[], 1e-6);
+        }
+    }
+}

@@ -8,6 +8,10 @@ impl Element for Joint {
         self.id
     }
 
+    fn drive_law_mut(&mut self) -> Option<&mut crate::elements::drive::TimeLaw> {
+        self.drive.as_mut()
+    }
+
     fn nodes(&self) -> &[usize] {
         &self.nodes
     }

@@ -216,6 +216,8 @@ impl Expr {
                 d1: Interval::point(1.0),
                 d2: Interval::point(0.0),
             }),
+            // A sensor is a number here only after `Expr::with_sensors`.
+            Expr::Sensor(_, at) => Err((*at, 0)),
             Expr::Neg(a, at) => check(a.interval_jet(x, order)?.neg(), *at),
             Expr::Bin(op, a, b, at) => {
                 let (a, b) = (a.interval_jet(x, order)?, b.interval_jet(x, order)?);
@@ -292,6 +294,7 @@ impl Expr {
                 d1: Interval::point(1.0),
                 d2: Interval::point(0.0),
             },
+            Expr::Sensor(..) => IJet::constant(f64::NAN),
             Expr::Neg(a, _) => a.forced_jet(x, sign, seen).neg(),
             Expr::Bin(op, a, b, _) => {
                 let (a, b) = (a.forced_jet(x, sign, seen), b.forced_jet(x, sign, seen));
