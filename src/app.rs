@@ -6,6 +6,7 @@
 //! `mecano-rs resume`).
 
 pub use locate::{locate, located_build_error};
+pub mod export;
 mod locate;
 pub mod memory;
 pub mod modes;
@@ -183,6 +184,8 @@ pub fn load_source(path: &Path, set: &[(String, f64)], refine: u32) -> Result<(M
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })?;
+    // A SUPERELEMENT's FILES are relative to the deck's directory.
+    model.resolve_superelement_dirs(path.parent().unwrap_or(Path::new(".")));
     apply_refine(path, &mut model, refine)?;
     Ok((model, text))
 }

@@ -36,7 +36,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 15] = [
+        const TYPES: [&str; 16] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -52,6 +52,7 @@ impl Builder<'_> {
             "PID",
             "PRESCRIBED",
             "CLEARANCE",
+            "SUPERELEMENT",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -254,6 +255,7 @@ impl Builder<'_> {
             "BUSHING" => Self::bushing_card(&mut c)?,
             "RSPRING" => self.rspring_card(&mut c, id)?,
             "PID" => self.pid_card(&mut c, id)?,
+            "SUPERELEMENT" => Self::superelement_card(&mut c)?,
             "PRESCRIBED" => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)

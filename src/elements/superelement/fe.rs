@@ -69,8 +69,7 @@ fn read_csv<T>(
         _ => "the header `dof,node,component`",
     };
     match lines.next() {
-        Some((_, h))
-            if h.split(',').map(str::trim).collect::<Vec<_>>().as_slice() == header => {}
+        Some((_, h)) if h.split(',').map(str::trim).collect::<Vec<_>>().as_slice() == header => {}
         Some((_, h)) => return Err(csv_err(path, 1, 1, expected, h)),
         None => return Err(csv_err(path, 1, 1, expected, "end of file")),
     }
@@ -107,13 +106,25 @@ pub fn read(dir: &Path) -> Result<FeModel, MtxError> {
     for (ln, f) in node_rows {
         let n = f[0];
         if n < 1.0 || n.fract() != 0.0 || n > f64::from(u32::MAX) {
-            return Err(csv_err(&p(FILES[2]), ln, 1, "a node number ≥ 1", &n.to_string()));
+            return Err(csv_err(
+                &p(FILES[2]),
+                ln,
+                1,
+                "a node number ≥ 1",
+                &n.to_string(),
+            ));
         }
         if nodes
             .insert(n as u32, Vector3::new(f[1], f[2], f[3]))
             .is_some()
         {
-            return Err(csv_err(&p(FILES[2]), ln, 1, "a node not listed before", &n.to_string()));
+            return Err(csv_err(
+                &p(FILES[2]),
+                ln,
+                1,
+                "a node not listed before",
+                &n.to_string(),
+            ));
         }
     }
     let dof_rows = read_csv(
@@ -127,18 +138,42 @@ pub fn read(dir: &Path) -> Result<FeModel, MtxError> {
     for (ln, f) in dof_rows {
         let dpath = p(FILES[3]);
         if f[0] != dofs.len() as u64 + 1 {
-            return Err(csv_err(&dpath, ln, 1, "the dofs numbered 1, 2, 3, … in order", &f[0].to_string()));
+            return Err(csv_err(
+                &dpath,
+                ln,
+                1,
+                "the dofs numbered 1, 2, 3, … in order",
+                &f[0].to_string(),
+            ));
         }
         let node = u32::try_from(f[1]).ok().filter(|n| nodes.contains_key(n));
         let Some(node) = node else {
-            return Err(csv_err(&dpath, ln, 2, "a node of nodes.csv", &f[1].to_string()));
+            return Err(csv_err(
+                &dpath,
+                ln,
+                2,
+                "a node of nodes.csv",
+                &f[1].to_string(),
+            ));
         };
         if !(1..=6).contains(&f[2]) {
-            return Err(csv_err(&dpath, ln, 3, "a component 1 to 6 (ux uy uz rx ry rz)", &f[2].to_string()));
+            return Err(csv_err(
+                &dpath,
+                ln,
+                3,
+                "a component 1 to 6 (ux uy uz rx ry rz)",
+                &f[2].to_string(),
+            ));
         }
         let c = (f[2] - 1) as u8;
         if !seen.insert((node, c)) {
-            return Err(csv_err(&dpath, ln, 2, "a (node, component) not listed before", &format!("{node},{}", f[2])));
+            return Err(csv_err(
+                &dpath,
+                ln,
+                2,
+                "a (node, component) not listed before",
+                &format!("{node},{}", f[2]),
+            ));
         }
         dofs.push((node, c));
     }

@@ -58,7 +58,9 @@ pub struct Body {
 
 /// The mass matrix is not positive definite on the reduced basis.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("the mass matrix is not positive definite on the reduced basis (rigid motions and kept modes): check M.mtx")]
+#[error(
+    "the mass matrix is not positive definite on the reduced basis (rigid motions and kept modes): check M.mtx"
+)]
 pub struct MassNotPositive;
 
 impl Body {

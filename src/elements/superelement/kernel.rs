@@ -89,7 +89,13 @@ fn vee<S: Real>(a: &Matrix3<S>) -> Vector3<S> {
 }
 
 /// The residual at `st` into `out` (local size, zeroed by the caller).
-pub fn residual<S: Real>(body: &Body, lay: Layout, st: &State<S>, ctx: &EvalContext, out: &mut [S]) {
+pub fn residual<S: Real>(
+    body: &Body,
+    lay: Layout,
+    st: &State<S>,
+    ctx: &EvalContext,
+    out: &mut [S],
+) {
     let n = body.n;
     let c = S::cst;
     let zero = S::zero();

@@ -81,8 +81,10 @@ impl Superelement {
             let fe_rel = fe.nodes[&a] - fe.nodes[&d.interface[0]];
             if (model_rel - fe_rel).norm() > PLACE_TOL * size {
                 return Err(invalid(format!(
-                    "interface node {a} (node {}) is at {:?} from the frame node in the deck but at {:?} in the FE model",
-                    model.nodes[nodes[i]].id, model_rel.as_slice(), fe_rel.as_slice()
+                    "FE interface node {a} ({}) is at {:?} from the frame node in the deck but at {:?} in the FE model",
+                    model.nodes[nodes[i]].id,
+                    model_rel.as_slice(),
+                    fe_rel.as_slice()
                 )));
             }
         }
@@ -128,7 +130,11 @@ impl Superelement {
         self.field(nodes, |s, j| s.x - self.q_ref[j])
     }
 
-    fn field(&self, nodes: &[NodeState], f: impl Fn(&NodeState, usize) -> Vector3<f64>) -> Vec<f64> {
+    fn field(
+        &self,
+        nodes: &[NodeState],
+        f: impl Fn(&NodeState, usize) -> Vector3<f64>,
+    ) -> Vec<f64> {
         let n = self.body.n;
         let mut out = Vec::with_capacity(n);
         for (j, &i) in self.nodes[1 + self.lay.nb..].iter().enumerate() {
@@ -249,7 +255,12 @@ impl Superelement {
         let b = &self.body;
         let n = b.n;
         let vv = st.r.transpose() * st.v0;
-        let nu: Vec<f64> = vv.iter().chain(st.w.iter()).chain(st.qd.iter()).copied().collect();
+        let nu: Vec<f64> = vv
+            .iter()
+            .chain(st.w.iter())
+            .chain(st.qd.iter())
+            .copied()
+            .collect();
         let mut mq = b.m0.clone();
         for k in 0..n {
             let gk = b.g.columns(3 * k, 3) * st.q[k];
@@ -397,8 +408,7 @@ impl Element for Superelement {
         let kq = &b.k * nalgebra::DVector::from_column_slice(&st.q);
         let lever = b.c0.norm() / b.mass.max(1e-300);
         let w2 = st.w.norm_squared() * lever;
-        b.mass * (st.a0.norm() + gravity.norm() + st.wd.norm() * lever + w2)
-            + kq.amax()
+        b.mass * (st.a0.norm() + gravity.norm() + st.wd.norm() * lever + w2) + kq.amax()
     }
 
     fn rotation_use(&self, k: usize) -> RotationUse {

@@ -79,7 +79,9 @@ pub enum MtxErrorKind {
     #[error("cannot read: {0}")]
     Io(String),
     /// The first line is not a Matrix Market banner of a real coordinate matrix.
-    #[error("expected the banner `%%MatrixMarket matrix coordinate real symmetric` (or `general`), found `{0}`")]
+    #[error(
+        "expected the banner `%%MatrixMarket matrix coordinate real symmetric` (or `general`), found `{0}`"
+    )]
     Banner(String),
     /// A kind of matrix this reader does not take (array, complex, pattern, skew…).
     #[error("{0} matrices are not read: write the matrix as `coordinate real symmetric`")]
@@ -212,7 +214,11 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
         .map(|w| w.to_ascii_lowercase())
         .collect();
     if words.len() != 5 || words[0] != "%%matrixmarket" || words[1] != "matrix" {
-        return Err((1, 1, MtxErrorKind::Banner(banner.chars().take(80).collect())));
+        return Err((
+            1,
+            1,
+            MtxErrorKind::Banner(banner.chars().take(80).collect()),
+        ));
     }
     if words[2] != "coordinate" {
         return Err((1, 1, MtxErrorKind::Unsupported(words[2].clone())));
@@ -235,7 +241,13 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
     let nums: Vec<Option<usize>> = f.iter().map(|x| x.parse().ok()).collect();
     let (rows, cols, nnz) = match nums.as_slice() {
         [Some(r), Some(c), Some(z)] => (*r, *c, *z),
-        _ => return Err((ln, 1, MtxErrorKind::SizeLine(size.chars().take(80).collect()))),
+        _ => {
+            return Err((
+                ln,
+                1,
+                MtxErrorKind::SizeLine(size.chars().take(80).collect()),
+            ));
+        }
     };
     if rows != cols {
         return Err((ln, 1, MtxErrorKind::NotSquare(rows, cols)));
@@ -251,15 +263,23 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
         }
         let mut it = line.split_whitespace();
         let index = |w: Option<&str>, what: &'static str| -> Result<usize, Located> {
-            let w = w.ok_or((ln, line.chars().count() + 1, MtxErrorKind::Field {
-                what,
-                found: "end of line".into(),
-            }))?;
-            let v: u64 = w.parse().map_err(|_| {
-                (ln, col_of(line, w), MtxErrorKind::Field {
+            let w = w.ok_or((
+                ln,
+                line.chars().count() + 1,
+                MtxErrorKind::Field {
                     what,
-                    found: w.chars().take(40).collect(),
-                })
+                    found: "end of line".into(),
+                },
+            ))?;
+            let v: u64 = w.parse().map_err(|_| {
+                (
+                    ln,
+                    col_of(line, w),
+                    MtxErrorKind::Field {
+                        what,
+                        found: w.chars().take(40).collect(),
+                    },
+                )
             })?;
             if v == 0 || v > n as u64 {
                 return Err((ln, col_of(line, w), MtxErrorKind::Index { index: v, n }));
@@ -268,21 +288,33 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
         };
         let i = index(it.next(), "a row index")?;
         let j = index(it.next(), "a column index")?;
-        let w = it.next().ok_or((ln, line.chars().count() + 1, MtxErrorKind::Field {
-            what: "a value",
-            found: "end of line".into(),
-        }))?;
-        let v: f64 = w.parse().map_err(|_| {
-            (ln, col_of(line, w), MtxErrorKind::Field {
+        let w = it.next().ok_or((
+            ln,
+            line.chars().count() + 1,
+            MtxErrorKind::Field {
                 what: "a value",
-                found: w.chars().take(40).collect(),
-            })
+                found: "end of line".into(),
+            },
+        ))?;
+        let v: f64 = w.parse().map_err(|_| {
+            (
+                ln,
+                col_of(line, w),
+                MtxErrorKind::Field {
+                    what: "a value",
+                    found: w.chars().take(40).collect(),
+                },
+            )
         })?;
         if !v.is_finite() {
             return Err((ln, col_of(line, w), MtxErrorKind::NotFinite(w.into())));
         }
         if let Some(t) = it.next() {
-            return Err((ln, col_of(line, t), MtxErrorKind::Trailing(t.chars().take(40).collect())));
+            return Err((
+                ln,
+                col_of(line, t),
+                MtxErrorKind::Trailing(t.chars().take(40).collect()),
+            ));
         }
         count += 1;
         if i >= j {
@@ -341,12 +373,16 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
 }
 
 fn asym(line: usize, i: usize, j: usize, a: f64, b: f64) -> Located {
-    (line, 1, MtxErrorKind::NotSymmetric {
-        i: i.min(j) + 1,
-        j: i.max(j) + 1,
-        a,
-        b,
-    })
+    (
+        line,
+        1,
+        MtxErrorKind::NotSymmetric {
+            i: i.min(j) + 1,
+            j: i.max(j) + 1,
+            a,
+            b,
+        },
+    )
 }
 
 /// Sorted by (column, row), duplicates summed.
@@ -382,11 +418,15 @@ mod tests {
 
     #[test]
     fn general_symmetric_is_accepted_and_asymmetric_refused() {
-        let g = "%%MatrixMarket matrix coordinate real general\n2 2 4\n1 1 1\n1 2 3\n2 1 3\n2 2 1\n";
+        let g =
+            "%%MatrixMarket matrix coordinate real general\n2 2 4\n1 1 1\n1 2 3\n2 1 3\n2 2 1\n";
         assert_eq!(parse(g).expect("symmetric").to_dense()[(0, 1)], 3.0);
         let bad = g.replace("2 1 3", "2 1 4");
         let (line, _, k) = parse(&bad).expect_err("asymmetric");
-        assert!(matches!(k, MtxErrorKind::NotSymmetric { i: 1, j: 2, .. }), "{k}");
+        assert!(
+            matches!(k, MtxErrorKind::NotSymmetric { i: 1, j: 2, .. }),
+            "{k}"
+        );
         assert_eq!(line, 4);
     }
 
@@ -395,18 +435,39 @@ mod tests {
         let cases: [(&str, usize, usize); 7] = [
             ("%%MatrixMarket matrix array real general\n2 2\n", 1, 1),
             ("hello\n", 1, 1),
-            ("%%MatrixMarket matrix coordinate real symmetric\n3 2 1\n", 2, 1),
-            ("%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n2 x 1\n", 4, 3),
-            ("%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n3 1 1\n", 4, 1),
-            ("%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n", 3, 1),
-            ("%%MatrixMarket matrix coordinate real symmetric\n2 2 1\n1 1 nan\n", 3, 5),
+            (
+                "%%MatrixMarket matrix coordinate real symmetric\n3 2 1\n",
+                2,
+                1,
+            ),
+            (
+                "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n2 x 1\n",
+                4,
+                3,
+            ),
+            (
+                "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n3 1 1\n",
+                4,
+                1,
+            ),
+            (
+                "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1\n",
+                3,
+                1,
+            ),
+            (
+                "%%MatrixMarket matrix coordinate real symmetric\n2 2 1\n1 1 nan\n",
+                3,
+                5,
+            ),
         ];
         for (text, line, col) in cases {
             let (l, c, k) = parse(text).expect_err(text);
             assert_eq!((l, c), (line, col), "{text}: {k}");
         }
-        let (_, _, k) = parse("%%MatrixMarket matrix coordinate real symmetric\n2 2 1\n1 1 1\n2 2 1\n")
-            .expect_err("too many");
+        let (_, _, k) =
+            parse("%%MatrixMarket matrix coordinate real symmetric\n2 2 1\n1 1 1\n2 2 1\n")
+                .expect_err("too many");
         assert_eq!(k, MtxErrorKind::TooMany(1));
     }
 }

@@ -45,7 +45,9 @@ pub struct Reduction {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ReduceError {
     /// An interface node the FE model does not have with all six components.
-    #[error("interface node {node}: the FE model has no component {component} of it (rows of dofs.csv: node, component 1–6)")]
+    #[error(
+        "interface node {node}: the FE model has no component {component} of it (rows of dofs.csv: node, component 1–6)"
+    )]
     InterfaceDof {
         /// FE node.
         node: u32,
@@ -56,7 +58,9 @@ pub enum ReduceError {
     #[error("FE node {0} is named twice in INTERFACE")]
     Repeated(u32),
     /// More modes asked for than interior dofs.
-    #[error("MODES {asked}: the FE model has {interior} interior degrees of freedom (dofs not on an interface node)")]
+    #[error(
+        "MODES {asked}: the FE model has {interior} interior degrees of freedom (dofs not on an interface node)"
+    )]
     TooManyModes {
         /// Asked for.
         asked: usize,
@@ -64,10 +68,14 @@ pub enum ReduceError {
         interior: usize,
     },
     /// `K_II` is not positive definite: the interface leaves part of the body free.
-    #[error("with its interface nodes held, the FE model is not held: its interior stiffness K_II is not positive definite (a part of the mesh connected to no interface node, or a stiffness that is not positive)")]
+    #[error(
+        "with its interface nodes held, the FE model is not held: its interior stiffness K_II is not positive definite (a part of the mesh connected to no interface node, or a stiffness that is not positive)"
+    )]
     NotHeld,
     /// A kept mode of zero (or negative) mass.
-    #[error("MODES {asked}: only {found} fixed-interface modes have mass (the mass matrix is not positive definite on the interior)")]
+    #[error(
+        "MODES {asked}: only {found} fixed-interface modes have mass (the mass matrix is not positive definite on the interior)"
+    )]
     Massless {
         /// Asked for.
         asked: usize,
@@ -75,7 +83,9 @@ pub enum ReduceError {
         found: usize,
     },
     /// Too large for the dense reduction.
-    #[error("{0} degrees of freedom: the dense reduction of this version takes at most {DENSE_MAX_DOFS}")]
+    #[error(
+        "{0} degrees of freedom: the dense reduction of this version takes at most {DENSE_MAX_DOFS}"
+    )]
     TooLarge(usize),
 }
 

@@ -36,7 +36,11 @@ pub(super) fn frame(corners: &[Vector3<f64>], per: usize) -> FeModel {
         let d = pts[e + 1] - pts[e];
         let l = d.norm();
         let ex = d / l;
-        let t = if ex.z.abs() < 0.9 { Vector3::z() } else { Vector3::x() };
+        let t = if ex.z.abs() < 0.9 {
+            Vector3::z()
+        } else {
+            Vector3::x()
+        };
         let ey = t.cross(&ex).normalize();
         let ez = ex.cross(&ey);
         let lam = Matrix3::from_rows(&[ex.transpose(), ey.transpose(), ez.transpose()]);
@@ -63,7 +67,9 @@ pub(super) fn frame(corners: &[Vector3<f64>], per: usize) -> FeModel {
             .enumerate()
             .map(|(i, p)| (i as u32 + 1, *p))
             .collect(),
-        dofs: (0..n).map(|r| ((r / 6) as u32 + 1, (r % 6) as u8)).collect(),
+        dofs: (0..n)
+            .map(|r| ((r / 6) as u32 + 1, (r % 6) as u8))
+            .collect(),
     }
 }
 
@@ -80,7 +86,12 @@ fn local(l: f64) -> (DMatrix<f64>, DMatrix<f64>) {
     put2(&mut k, [0, 6], E * A / l, [[1.0, -1.0], [-1.0, 1.0]]);
     put2(&mut k, [3, 9], G * J / l, [[1.0, -1.0], [-1.0, 1.0]]);
     put2(&mut m, [0, 6], RHO * A * l / 6.0, [[2.0, 1.0], [1.0, 2.0]]);
-    put2(&mut m, [3, 9], RHO * (IY + IZ) * l / 6.0, [[2.0, 1.0], [1.0, 2.0]]);
+    put2(
+        &mut m,
+        [3, 9],
+        RHO * (IY + IZ) * l / 6.0,
+        [[2.0, 1.0], [1.0, 2.0]],
+    );
     let kb = |ei: f64| {
         let c = ei / l.powi(3);
         [
@@ -93,9 +104,19 @@ fn local(l: f64) -> (DMatrix<f64>, DMatrix<f64>) {
     let c = RHO * A * l / 420.0;
     let mb = [
         [156.0 * c, 22.0 * l * c, 54.0 * c, -13.0 * l * c],
-        [22.0 * l * c, 4.0 * l * l * c, 13.0 * l * c, -3.0 * l * l * c],
+        [
+            22.0 * l * c,
+            4.0 * l * l * c,
+            13.0 * l * c,
+            -3.0 * l * l * c,
+        ],
         [54.0 * c, 13.0 * l * c, 156.0 * c, -22.0 * l * c],
-        [-13.0 * l * c, -3.0 * l * l * c, -22.0 * l * c, 4.0 * l * l * c],
+        [
+            -13.0 * l * c,
+            -3.0 * l * l * c,
+            -22.0 * l * c,
+            4.0 * l * l * c,
+        ],
     ];
     let put4 = |a: &mut DMatrix<f64>, dofs: [usize; 4], b: [[f64; 4]; 4], sign: [f64; 4]| {
         for i in 0..4 {
@@ -116,7 +137,11 @@ fn local(l: f64) -> (DMatrix<f64>, DMatrix<f64>) {
 /// to 2·per + 1.
 pub(super) fn l_frame(per: usize) -> FeModel {
     frame(
-        &[Vector3::zeros(), Vector3::new(1.0, 0.0, 0.0), Vector3::new(1.0, 0.8, 0.3)],
+        &[
+            Vector3::zeros(),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.8, 0.3),
+        ],
         per,
     )
 }
@@ -162,7 +187,11 @@ fn clamped_eigenvalues_converge_to_the_full_model() {
         if modes < interior {
             let next = body_of(&fe, &[1, 9], modes + 1);
             let cut = next.omega2[modes];
-            assert!(e <= full[4] / cut, "{modes} modes: {e} above {}", full[4] / cut);
+            assert!(
+                e <= full[4] / cut,
+                "{modes} modes: {e} above {}",
+                full[4] / cut
+            );
         }
         last = e;
     }
@@ -297,8 +326,16 @@ fn forces_are_the_energy_rate() {
     let mut power = 0.0;
     for k in [0, 2, 3, 4, 5] {
         let s = &nodes[k];
-        power += out.res[6 * k..6 * k + 3].iter().zip(s.v.iter()).map(|(a, b)| a * b).sum::<f64>();
-        power += out.res[6 * k + 3..6 * k + 6].iter().zip(s.w.iter()).map(|(a, b)| a * b).sum::<f64>();
+        power += out.res[6 * k..6 * k + 3]
+            .iter()
+            .zip(s.v.iter())
+            .map(|(a, b)| a * b)
+            .sum::<f64>();
+        power += out.res[6 * k + 3..6 * k + 6]
+            .iter()
+            .zip(s.w.iter())
+            .map(|(a, b)| a * b)
+            .sum::<f64>();
     }
     let at = |h: f64| -> f64 {
         let moved: Vec<NodeState> = nodes
@@ -367,9 +404,18 @@ fn bad_reductions_are_refused() {
     let fe = l_frame(2);
     let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
     let e = reduce(&fe, &k, &m, &[1, 99], 2).expect_err("no node 99");
-    assert!(matches!(e, reduce::ReduceError::InterfaceDof { node: 99, .. }));
+    assert!(matches!(
+        e,
+        reduce::ReduceError::InterfaceDof { node: 99, .. }
+    ));
     let e = reduce(&fe, &k, &m, &[1], 1000).expect_err("too many");
-    assert!(matches!(e, reduce::ReduceError::TooManyModes { asked: 1000, interior: 24 }));
+    assert!(matches!(
+        e,
+        reduce::ReduceError::TooManyModes {
+            asked: 1000,
+            interior: 24
+        }
+    ));
     // Two frames not connected: with node 1 held, the other one is free.
     let mut two = fe.clone();
     let n = fe.dofs.len();
@@ -383,9 +429,11 @@ fn bad_reductions_are_refused() {
     two.m = SymMatrix::from_dense(&mm, 0.0);
     let offset = fe.nodes.len() as u32;
     for (p, x) in fe.nodes.iter() {
-        two.nodes.insert(p + offset, x + Vector3::new(0.0, 0.0, 5.0));
+        two.nodes
+            .insert(p + offset, x + Vector3::new(0.0, 0.0, 5.0));
     }
-    two.dofs.extend(fe.dofs.iter().map(|&(p, c)| (p + offset, c)));
+    two.dofs
+        .extend(fe.dofs.iter().map(|&(p, c)| (p + offset, c)));
     let e = reduce(&two, &kk, &mm, &[1], 2).expect_err("free part");
     assert_eq!(e, reduce::ReduceError::NotHeld);
 }
