@@ -209,6 +209,9 @@ fn free_flight_conserves_energy() {
     assert!(d1 < 1e-4 && d2 < d1 / 3.0, "{d1} {d2}");
 }
 
+/// A change made to a copy of the files or the deck.
+type Edit = Box<dyn Fn(&Path)>;
+
 /// Bad input: located errors, exit 2, nothing written.
 #[test]
 fn bad_files_are_refused_located() {
@@ -229,7 +232,7 @@ fn bad_files_are_refused_located() {
         assert!(t.contains(from), "{from}");
         std::fs::write(&p, t.replacen(from, to, 1)).expect("write");
     };
-    let cases: Vec<(&str, Box<dyn Fn(&Path)>, &str)> = vec![
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "truncated",
             Box::new(|c: &Path| {
