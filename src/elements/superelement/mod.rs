@@ -411,6 +411,21 @@ impl Element for Superelement {
         b.mass * (st.a0.norm() + gravity.norm() + st.wd.norm() * lever + w2) + kq.amax()
     }
 
+    fn summary(&self) -> Option<serde_json::Value> {
+        let b = &self.body;
+        let hz: Vec<f64> = b
+            .omega2
+            .iter()
+            .map(|w2| w2.sqrt() / (2.0 * std::f64::consts::PI))
+            .collect();
+        Some(serde_json::json!({
+            "mass_kg": b.mass,
+            "elastic_coordinates": b.n,
+            "interface_nodes": self.lay.nb + 1,
+            "fixed_interface_modes_hz": hz,
+        }))
+    }
+
     fn rotation_use(&self, k: usize) -> RotationUse {
         if k > self.lay.nb {
             RotationUse::Never

@@ -82,6 +82,24 @@ pub enum ReduceError {
         /// With positive mass.
         found: usize,
     },
+    /// The kept modes end inside a multiple eigenvalue: which vectors of its eigenspace
+    /// are kept is arbitrary (a rotated FE model would keep others), so the model would
+    /// not be objective.
+    #[error(
+        "MODES {asked} keeps part of {count} fixed-interface modes of equal frequency ({hz:.6e} Hz): keep {below} or {above}"
+    )]
+    SplitsMultiple {
+        /// Asked for.
+        asked: usize,
+        /// The multiplicity.
+        count: usize,
+        /// Their frequency, Hz.
+        hz: f64,
+        /// The nearest counts that keep the eigenspace whole.
+        below: usize,
+        /// Above.
+        above: usize,
+    },
     /// Too large for the dense reduction.
     #[error(
         "{0} degrees of freedom: the dense reduction of this version takes at most {DENSE_MAX_DOFS}"
@@ -165,6 +183,7 @@ pub fn reduce(
                     found,
                 });
             }
+            check_whole(&mu, modes)?;
             let l = chol.l();
             for (c, (&mu_c, yc)) in mu.iter().zip(y.column_iter()).take(modes).enumerate() {
                 // φ = L⁻ᵀ y / √μ: φᵀ M_II φ = 1, φᵀ K_II φ = 1/μ = ω².
@@ -187,6 +206,36 @@ pub fn reduce(
         basis,
         k: k_red,
         omega2,
+    })
+}
+
+/// Relative difference of `μ` below which two fixed-interface modes are one multiple
+/// eigenvalue (a symmetric section's two bending modes agree to ~1e-13).
+const MULTIPLE_TOL: f64 = 1e-9;
+
+/// Refuses a count of modes that ends inside a multiple eigenvalue (`mu` descending).
+fn check_whole(mu: &[f64], modes: usize) -> Result<(), ReduceError> {
+    if modes == 0 || modes >= mu.len() {
+        return Ok(());
+    }
+    let same = |a: f64, b: f64| (a - b).abs() <= MULTIPLE_TOL * a.abs();
+    if !same(mu[modes - 1], mu[modes]) {
+        return Ok(());
+    }
+    let mut lo = modes - 1;
+    while lo > 0 && same(mu[lo - 1], mu[modes - 1]) {
+        lo -= 1;
+    }
+    let mut hi = modes;
+    while hi < mu.len() && same(mu[hi], mu[modes - 1]) {
+        hi += 1;
+    }
+    Err(ReduceError::SplitsMultiple {
+        asked: modes,
+        count: hi - lo,
+        hz: (1.0 / mu[modes - 1]).sqrt() / (2.0 * std::f64::consts::PI),
+        below: lo,
+        above: hi,
     })
 }
 
