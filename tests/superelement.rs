@@ -425,3 +425,41 @@ fn a_rotated_fe_model_gives_the_rotated_motion() {
     );
     assert!(dx < 1e-8 && de < 1e-10, "{dx} {de}");
 }
+
+/// Every integrator advances the superelement unchanged (its coordinates are nodes): the
+/// flexible pendulum (8 modes) under generalized-α, ESDIRK3 and ESDIRK5 against the
+/// beams under the same scheme, within the HHT figure of
+/// `flexible_pendulum_converges_with_modes` (3.4e-6 m at h = 1e-3).
+#[test]
+fn every_integrator_runs_the_superelement() {
+    let dir = common::TempDir::new("se_schemes");
+    let src = common::root().join("decks/superelement");
+    std::fs::create_dir_all(dir.join("beam")).expect("dir");
+    for f in fe::FILES {
+        std::fs::copy(src.join("beam").join(f), dir.join("beam").join(f)).expect("copy");
+    }
+    for scheme in ["GENALPHA RHOINF 0.8", "ESDIRK3", "ESDIRK5"] {
+        let mut tips = Vec::new();
+        for deck in ["pendulum_beams.dat", "pendulum_se.dat"] {
+            let text = std::fs::read_to_string(src.join(deck)).expect("deck");
+            let text = text
+                .replace("ALPHA 0 STEP", &format!("{scheme} STEP"))
+                .replace("  modes 4\n", "  modes 8\n");
+            let path = dir.join(deck);
+            std::fs::write(&path, text).expect("write");
+            let model = mecano::deck::load_deck(&path).expect("deck");
+            let i = model.nodes.get_index_of(&NodeId(2)).expect("tip");
+            let mut h = History::new(1);
+            let r = mecano::solver::run(&model, &mut h).expect("starts");
+            assert!(r.failure.is_none(), "{scheme} {deck}: {:?}", r.failure);
+            tips.push(h.nodes.iter().map(|s| s[i].x).collect::<Vec<_>>());
+        }
+        assert_eq!(tips[0].len(), tips[1].len());
+        let d = tips[0]
+            .iter()
+            .zip(&tips[1])
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).norm()));
+        eprintln!("{scheme}: largest tip distance, superelement (8 modes) to beams: {d:.2e} m");
+        assert!(d < 4e-6, "{scheme}: {d}");
+    }
+}

@@ -84,6 +84,154 @@ pub struct State<S: Real> {
     pub lam: Vec<S>,
 }
 
+/// The deformation-dependent inertia terms, `O(n²)` to form: `G(q)`, `G(q̇)` (`(6 + n) × 3`)
+/// and `HQ_k = Σ_l H_kl q_l`. Formed once in `f64` per evaluation; a tangent pass seeded on
+/// one coordinate adds its derivative (`G_j`, `c_v G_j`, `H_kj`) in `O(n)`
+/// ([`Pre::seeded`]), so that a tangent costs `O(n)` passes of `O(n²)`, not `O(n³)` each.
+#[derive(Debug, Clone)]
+pub struct Pre<S: Real> {
+    /// `G(q)`, by row of `ν`.
+    pub gq: Vec<Vector3<S>>,
+    /// `G(q̇)`.
+    pub gqd: Vec<Vector3<S>>,
+    /// `HQ_k`.
+    pub hq: Vec<Matrix3<S>>,
+    /// `ν`, `ν̇` at the evaluation's state, and `𝕄₀ν`, `𝕄₀ν̇`, `Gᵀν` (`3n`) there: a pass
+    /// adds only what its seeded direction changes (`O(n)` per changed entry).
+    pub base: Base,
+}
+
+/// `f64` products at the evaluation's state ([`Pre::base`]).
+#[derive(Debug, Clone, Default)]
+pub struct Base {
+    nu: Vec<f64>,
+    nud: Vec<f64>,
+    m0nu: Vec<f64>,
+    m0nud: Vec<f64>,
+    gtn: Vec<f64>,
+}
+
+/// `Aᵀ x` for `x` near `xb`, `Aᵀ xb = ab` known (as [`times_near`]).
+fn times_near_t<S: Real>(a: &nalgebra::DMatrix<f64>, x: &[S], xb: &[f64], ab: &[f64]) -> Vec<S> {
+    let mut y: Vec<S> = ab.iter().map(|v| S::cst(*v)).collect();
+    for (i, (xi, xbi)) in x.iter().zip(xb).enumerate() {
+        let d = *xi - S::cst(*xbi);
+        if d.is_zero() {
+            continue;
+        }
+        for (k, yk) in y.iter_mut().enumerate() {
+            *yk += S::cst(a[(i, k)]) * d;
+        }
+    }
+    y
+}
+
+/// `ν = [Rᵀẋ₀; Ω; q̇]` and `ν̇ = [Rᵀẍ₀ − Ω × V; Ω̇; q̈]` of a state.
+fn velocities<S: Real>(st: &State<S>) -> (Vec<S>, Vec<S>) {
+    let rt = st.r.transpose();
+    let vv = rt * st.v0;
+    let mut nu = Vec::with_capacity(6 + st.qd.len());
+    nu.extend(vv.iter().copied());
+    nu.extend(st.w.iter().copied());
+    nu.extend(st.qd.iter().copied());
+    let vdot = rt * st.a0 - st.w.cross(&vv);
+    let mut nud = Vec::with_capacity(6 + st.qd.len());
+    nud.extend(vdot.iter().copied());
+    nud.extend(st.wd.iter().copied());
+    nud.extend(st.qdd.iter().copied());
+    (nu, nud)
+}
+
+/// `A x` for `x` near `xb`, `A xb = ab` known: `ab + Σ_{j: x_j ≠ xb_j} A[:, j](x_j − xb_j)`.
+fn times_near<S: Real>(a: &nalgebra::DMatrix<f64>, x: &[S], xb: &[f64], ab: &[f64]) -> Vec<S> {
+    let mut y: Vec<S> = ab.iter().map(|v| S::cst(*v)).collect();
+    for (j, (xj, xbj)) in x.iter().zip(xb).enumerate() {
+        let d = *xj - S::cst(*xbj);
+        if d.is_zero() {
+            continue;
+        }
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi += S::cst(a[(i, j)]) * d;
+        }
+    }
+    y
+}
+
+impl Pre<f64> {
+    /// The terms at the state `st`.
+    pub fn new(body: &Body, st: &State<f64>) -> Self {
+        let (q, qd) = (&st.q, &st.qd);
+        let n = body.n;
+        let mut gq = vec![Vector3::zeros(); 6 + n];
+        let mut gqd = vec![Vector3::zeros(); 6 + n];
+        for (i, (a, b)) in gq.iter_mut().zip(gqd.iter_mut()).enumerate() {
+            for k in 0..n {
+                for j in 0..3 {
+                    let gv = body.g[(i, 3 * k + j)];
+                    a[j] += gv * q[k];
+                    b[j] += gv * qd[k];
+                }
+            }
+        }
+        let mut hq = vec![Matrix3::zeros(); n];
+        for (k, hk) in hq.iter_mut().enumerate() {
+            for (l, ql) in q.iter().enumerate() {
+                if *ql != 0.0 {
+                    *hk += body.h.fixed_view::<3, 3>(3 * k, 3 * l) * *ql;
+                }
+            }
+        }
+        let (nu, nud) = velocities(st);
+        let mv = |x: &[f64]| {
+            (&body.m0 * nalgebra::DVector::from_column_slice(x))
+                .as_slice()
+                .to_vec()
+        };
+        let gtn = (body.g.transpose() * nalgebra::DVector::from_column_slice(&nu))
+            .as_slice()
+            .to_vec();
+        let base = Base {
+            m0nu: mv(&nu),
+            m0nud: mv(&nud),
+            gtn,
+            nu,
+            nud,
+        };
+        Pre { gq, gqd, hq, base }
+    }
+
+    /// The terms in `Dual<2>` for a pass seeded on coordinate `j` (`ε₀` on `q_j`, `ε₁ c_v`
+    /// on `q̇_j`), or on no coordinate (`None`: constants).
+    pub fn seeded(&self, body: &Body, j: Option<usize>, c_v: f64) -> Pre<crate::dual::Dual<2>> {
+        use crate::dual::Dual;
+        let v = |x: &Vector3<f64>| x.map(Dual::<2>::constant);
+        let mut p = Pre {
+            gq: self.gq.iter().map(v).collect(),
+            gqd: self.gqd.iter().map(v).collect(),
+            hq: self.hq.iter().map(|m| m.map(Dual::<2>::constant)).collect(),
+            base: self.base.clone(),
+        };
+        if let Some(j) = j {
+            for (i, (a, b)) in p.gq.iter_mut().zip(p.gqd.iter_mut()).enumerate() {
+                for c in 0..3 {
+                    let gv = body.g[(i, 3 * j + c)];
+                    a[c].eps[0] += gv;
+                    b[c].eps[1] += c_v * gv;
+                }
+            }
+            for (k, hk) in p.hq.iter_mut().enumerate() {
+                let hkj = body.h.fixed_view::<3, 3>(3 * k, 3 * j);
+                for r in 0..3 {
+                    for c in 0..3 {
+                        hk[(r, c)].eps[0] += hkj[(r, c)];
+                    }
+                }
+            }
+        }
+        p
+    }
+}
+
 fn vee<S: Real>(a: &Matrix3<S>) -> Vector3<S> {
     Vector3::new(a[(2, 1)], a[(0, 2)], a[(1, 0)])
 }
@@ -93,6 +241,7 @@ pub fn residual<S: Real>(
     body: &Body,
     lay: Layout,
     st: &State<S>,
+    pre: &Pre<S>,
     ctx: &EvalContext,
     out: &mut [S],
 ) {
@@ -104,56 +253,22 @@ pub fn residual<S: Real>(
     let mut f_t = Vector3::repeat(zero);
     let mut f_q = vec![zero; n];
     if ctx.dynamic {
-        let vv = rt * st.v0;
         let w = st.w;
-        let mut nu = Vec::with_capacity(6 + n);
-        nu.extend(vv.iter().copied());
-        nu.extend(w.iter().copied());
-        nu.extend(st.qd.iter().copied());
-        let vdot = rt * st.a0 - w.cross(&vv);
-        let mut nud = Vec::with_capacity(6 + n);
-        nud.extend(vdot.iter().copied());
-        nud.extend(st.wd.iter().copied());
-        nud.extend(st.qdd.iter().copied());
-        let m6 = 6 + n;
-        // G(q), G(q̇): (6+n) × 3.
-        let mut gq = vec![Vector3::repeat(zero); m6];
-        let mut gqd = vec![Vector3::repeat(zero); m6];
-        for (i, (a, b)) in gq.iter_mut().zip(gqd.iter_mut()).enumerate() {
-            for k in 0..n {
-                for j in 0..3 {
-                    let gv = c(body.g[(i, 3 * k + j)]);
-                    a[j] += gv * st.q[k];
-                    b[j] += gv * st.qd[k];
-                }
-            }
-        }
-        // HQ_k = Σ_l H_kl q_l (3 × 3 per k); H(q,q) = Σ_k q_k HQ_k, H(q̇,q) = Σ_k q̇_k HQ_k.
-        let mut hq = vec![Matrix3::repeat(zero); n];
-        for (k, hk) in hq.iter_mut().enumerate() {
-            for l in 0..n {
-                for a in 0..3 {
-                    for j in 0..3 {
-                        hk[(a, j)] += c(body.h[(3 * k + a, 3 * l + j)]) * st.q[l];
-                    }
-                }
-            }
-        }
+        let (nu, nud) = velocities(st);
+        let vv = Vector3::new(nu[0], nu[1], nu[2]);
+        let (gq, gqd, hq) = (&pre.gq, &pre.gqd, &pre.hq);
         let mut hqq = Matrix3::repeat(zero);
         let mut hdq = Matrix3::repeat(zero);
         for k in 0..n {
             hqq += hq[k] * st.q[k];
             hdq += hq[k] * st.qd[k];
         }
-        let mv = |x: &[S]| -> Vec<S> {
+        let b = &pre.base;
+        let mv = |x: &[S], xb: &[f64], m0xb: &[f64]| -> Vec<S> {
             let xw = Vector3::new(x[3], x[4], x[5]);
-            let mut y = vec![zero; m6];
+            let mut y = times_near(&body.m0, x, xb, m0xb);
             for (i, yi) in y.iter_mut().enumerate() {
-                let mut s = gq[i].dot(&xw);
-                for (j, xj) in x.iter().enumerate() {
-                    s += c(body.m0[(i, j)]) * *xj;
-                }
-                *yi = s;
+                *yi += gq[i].dot(&xw);
             }
             let mut gtx = Vector3::repeat(zero);
             for (i, xi) in x.iter().enumerate() {
@@ -165,8 +280,10 @@ pub fn residual<S: Real>(
             }
             y
         };
-        let p = mv(&nu);
-        let mut pd = mv(&nud);
+        let p = mv(&nu, &b.nu, &b.m0nu);
+        let mut pd = mv(&nud, &b.nud, &b.m0nud);
+        // Gᵀν (3n), near its value at the state.
+        let gtn = times_near_t(&body.g, &nu, &b.nu, &b.gtn);
         // 𝕄̇ν.
         let mut gdtn = Vector3::repeat(zero);
         for (i, ni) in nu.iter().enumerate() {
@@ -186,10 +303,8 @@ pub fn residual<S: Real>(
         for k in 0..n {
             // ∂T/∂q_k = νᵀ G_k Ω + Ωᵀ HQ_k Ω.
             let mut dt = w.dot(&(hq[k] * w));
-            for (i, ni) in nu.iter().enumerate() {
-                for j in 0..3 {
-                    dt += *ni * c(body.g[(i, 3 * k + j)]) * w[j];
-                }
+            for j in 0..3 {
+                dt += gtn[3 * k + j] * w[j];
             }
             f_q[k] += pd[6 + k] - dt;
         }

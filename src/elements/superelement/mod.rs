@@ -26,7 +26,7 @@ use super::{BuildError, Element, Energies, EvalContext, Local, NodeState, Rotati
 use crate::dual::Dual;
 use crate::model::{ElementId, Model, SuperelementData};
 use invariants::Body;
-use kernel::{Layout, State};
+use kernel::{Layout, Pre, State};
 use nalgebra::{Matrix3, Vector3};
 
 /// Tolerance on an interface node's place: the model node and the FE node must be at the
@@ -238,6 +238,16 @@ impl Superelement {
         d
     }
 
+    /// The elastic coordinate local direction `dir` moves, if any.
+    fn coordinate_of(&self, dir: usize) -> Option<usize> {
+        let lay = self.lay;
+        if dir >= lay.lambda_row() || dir < 6 * (1 + lay.nb) || dir % 6 >= 3 {
+            return None;
+        }
+        let k = 3 * (dir / 6 - 1 - lay.nb) + dir % 6;
+        (k < self.body.n).then_some(k)
+    }
+
     /// Whether local direction `dir` is one the element depends on (not a modal node's
     /// rotation or unused translation).
     fn active(&self, dir: usize) -> bool {
@@ -325,7 +335,8 @@ impl Element for Superelement {
         let st = self.state(nodes, lambda);
         let size = self.lay.size();
         let mut r = vec![0.0; size];
-        kernel::residual(&self.body, self.lay, &st, ctx, &mut r);
+        let pre = Pre::new(&self.body, &st);
+        kernel::residual(&self.body, self.lay, &st, &pre, ctx, &mut r);
         for (o, v) in out.res.iter_mut().zip(&r) {
             *o += v;
         }
@@ -335,8 +346,9 @@ impl Element for Superelement {
         let mut rd = vec![Dual::<2>::constant(0.0); size];
         for col in (0..size).filter(|&c| self.active(c)) {
             let sd = self.seeded(&st, col, ctx);
+            let pd = pre.seeded(&self.body, self.coordinate_of(col), ctx.c_v);
             rd.iter_mut().for_each(|x| *x = Dual::constant(0.0));
-            kernel::residual(&self.body, self.lay, &sd, ctx, &mut rd);
+            kernel::residual(&self.body, self.lay, &sd, &pd, ctx, &mut rd);
             for (row, v) in rd.iter().enumerate() {
                 let (dq, rate) = (v.eps[0], v.eps[1]);
                 if dq != 0.0 || rate != 0.0 {
@@ -396,7 +408,8 @@ impl Element for Superelement {
             h: 0.0,
         };
         let mut r = vec![0.0; self.lay.size()];
-        kernel::residual(&self.body, self.lay, &st, &ctx, &mut r);
+        let pre = Pre::new(&self.body, &st);
+        kernel::residual(&self.body, self.lay, &st, &pre, &ctx, &mut r);
         r[self.lay.lambda_row()..]
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()))
