@@ -55,7 +55,7 @@ pub fn run(args: &ExportArgs) -> u8 {
         Err(e) => {
             eprintln!(
                 "error: {}",
-                app::locate::located_build_error(&args.deck, &e)
+                app::locate::located_model_error(&args.deck, &model, &e)
             );
             return EXIT_BAD_INPUT;
         }
