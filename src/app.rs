@@ -5,7 +5,8 @@
 //! interrupted (SIGINT or SIGTERM: whole rows kept, a checkpoint to go on from with
 //! `mecano-rs resume`).
 
-pub use locate::{locate, located_build_error};
+pub use locate::{locate, located_build_error, located_model_error};
+pub mod export;
 mod locate;
 pub mod memory;
 pub mod modes;
@@ -183,6 +184,8 @@ pub fn load_source(path: &Path, set: &[(String, f64)], refine: u32) -> Result<(M
         eprintln!("{:?}", miette::Report::new(errs));
         EXIT_BAD_INPUT
     })?;
+    // A SUPERELEMENT's FILES are relative to the deck's directory.
+    model.resolve_superelement_dirs(path.parent().unwrap_or(Path::new(".")));
     apply_refine(path, &mut model, refine)?;
     Ok((model, text))
 }
@@ -280,7 +283,7 @@ pub fn check(path: &Path, set: &[(String, f64)], refine: u32) -> u8 {
             EXIT_OK
         }
         Err(e) => {
-            eprintln!("error: {}", located_build_error(path, &e));
+            eprintln!("error: {}", located_model_error(path, &model, &e));
             EXIT_BAD_INPUT
         }
     }
@@ -423,7 +426,7 @@ fn start_session(
 ) -> Result<RunReport, (u8, String)> {
     let integ = solver::prepare(model).map_err(|e| {
         // The caller prefixes the deck's name: the place follows as line and column.
-        let text = located_build_error(Path::new(deck_name), &e);
+        let text = located_model_error(Path::new(deck_name), model, &e);
         let text = text
             .strip_prefix(deck_name)
             .and_then(|t| t.strip_prefix(':'))

@@ -102,6 +102,10 @@ restart is refused: no valid checkpoint, a complete run, or a deck whose text di
 2 bad input (deck errors, --count above the free unknowns, --at outside the deck's time, nothing to vibrate)."
     )]
     Modes(mecano::app::modes::ModesArgs),
+    /// The linear K and M of a deck's structure at its reference state as Matrix Market
+    /// files with its nodes and dof map: what a SUPERELEMENT reads (docs/superelements.md).
+    #[command(after_help = "Exit codes: 0 done; 1 a file could not be written; 2 bad input.")]
+    Export(mecano::app::export::ExportArgs),
     /// Parameter study: run the cases of a plan (TOML) in parallel, or emit a Slurm job
     /// array, and collect sweep.csv, statistics and figures.
     Sweep(mecano::sweep::SweepArgs),
@@ -134,6 +138,7 @@ fn main() -> ExitCode {
         (Some(Command::Compare(args)), _) => mecano::compare::run(args),
         (Some(Command::Sweep(args)), _) => mecano::sweep::run(args),
         (Some(Command::Modes(args)), _) => mecano::app::modes::run(args),
+        (Some(Command::Export(args)), _) => mecano::app::export::run(args),
         (None, Some(deck)) if cli.check => mecano::app::check(deck, &cli.set, cli.refine),
         (None, Some(deck)) => mecano::app::run(
             deck,

@@ -32,3 +32,22 @@ pub fn located_build_error(path: &Path, e: &solver::BuildError) -> String {
         other => format!("{}: {other}", path.display()),
     }
 }
+
+/// [`located_build_error`], an element's own error (a `SUPERELEMENT`'s files, a beam's
+/// data) placed at its card in `model`'s deck.
+pub fn located_model_error(
+    path: &Path,
+    model: &crate::model::Model,
+    e: &solver::BuildError,
+) -> String {
+    use crate::elements::BuildError as E;
+    match e {
+        solver::BuildError::Elements(E::Invalid { element, .. }) => {
+            match model.elements.get(element) {
+                Some(el) => format!("{}: {e}", locate_offset(path, el.span.start)),
+                None => located_build_error(path, e),
+            }
+        }
+        _ => located_build_error(path, e),
+    }
+}

@@ -363,6 +363,21 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "BUSHING: axes e1 e2 of its frame, global at t = 0",
     ),
     kw(
+        "SUPERELEMENT",
+        "ELEMENTS",
+        "a linear elastic body reduced from an FE model (Craig–Bampton in a floating frame)",
+    ),
+    kw(
+        "FILES",
+        "ELEMENTS",
+        "SUPERELEMENT: directory of K.mtx, M.mtx, nodes.csv, dofs.csv (relative to the deck's)",
+    ),
+    kw(
+        "INTERFACE",
+        "ELEMENTS",
+        "SUPERELEMENT: pairs <FE node> <node>; the first is the frame node",
+    ),
+    kw(
         "RSPRING",
         "ELEMENTS",
         "rotational spring, damper and friction on a HINGE element",
@@ -500,7 +515,7 @@ pub const KEYWORDS: &[KeywordDoc] = &[
     kw(
         "MODES",
         "ANALYSIS",
-        "modal analysis: the lowest n modes about the initial state",
+        "modal analysis: the lowest n modes about the initial state; SUPERELEMENT: fixed-interface modes kept",
     ),
     kw(
         "ROTATING",

@@ -101,7 +101,9 @@ pub fn load_deck(path: &Path) -> Result<Model, DeckErrors> {
 /// [`read_source`]: a regular file or a pipe, at most the size limit plus one byte.
 pub fn load_deck_with(path: &Path, overrides: &[(String, f64)]) -> Result<Model, DeckErrors> {
     let text = read_source(path)?;
-    parse_deck_with(&text, &path.display().to_string(), overrides)
+    let mut model = parse_deck_with(&text, &path.display().to_string(), overrides)?;
+    model.resolve_superelement_dirs(path.parent().unwrap_or(Path::new(".")));
+    Ok(model)
 }
 
 /// Sets every span in `model` to `Span::default()` (to compare models read from different

@@ -92,6 +92,7 @@ pub fn write_deck(model: &Model) -> String {
         .values()
         .flat_map(|d| d.interior.iter().copied())
         .chain(model.order_nodes.values().flatten().copied())
+        .chain(model.modal_nodes())
         .collect();
     let gen_elements: HashSet<ElementId> = model
         .divisions
@@ -204,6 +205,8 @@ pub fn write_deck(model: &Model) -> String {
                 }
                 None => match &e.kind {
                     ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
+                    // Its interface nodes follow INTERFACE; its modal nodes are generated.
+                    ElementKind::Superelement(_) => Vec::new(),
                     ElementKind::Control(c) => match (c.actuator, &c.law) {
                         (crate::model::control::Actuator::HingeTorque(h), ControlLaw::Pid(_)) => {
                             vec![h.0.to_string()]
@@ -306,6 +309,12 @@ pub fn write_deck(model: &Model) -> String {
                     if b.axes != Matrix3::identity() {
                         let col = |i: usize| v3(&b.axes.column(i).into_owned());
                         let _ = write!(s, " AXES {} {}", col(0), col(1));
+                    }
+                }
+                ElementKind::Superelement(d) => {
+                    let _ = write!(s, "FILES {} MODES {} INTERFACE", d.dir.display(), d.modes);
+                    for (fe, node) in d.interface.iter().zip(&e.nodes) {
+                        let _ = write!(s, " {fe} {}", node.0);
                     }
                 }
                 ElementKind::Control(c) => match &c.law {

@@ -29,6 +29,7 @@ pub mod profile;
 pub mod rigid_bar;
 pub mod rspring;
 pub mod spring;
+pub mod superelement;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -131,6 +132,7 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
             ElementKind::Spring(_) | ElementKind::Bushing(_) | ElementKind::RSpring(_) => {
                 out.push(spring::from_model(model, el)?)
             }
+            ElementKind::Superelement(d) => out.push(superelement::from_model(model, el, d)?),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }

@@ -167,7 +167,7 @@ impl Numbering {
         }
     }
 
-    fn node(&mut self) -> Result<NodeId, MeshError> {
+    pub(crate) fn node(&mut self) -> Result<NodeId, MeshError> {
         let n = u32::try_from(self.next_node).map_err(|_| MeshError::Overflow { what: "node" })?;
         self.next_node += 1;
         Ok(NodeId(n))

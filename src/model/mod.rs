@@ -21,6 +21,7 @@ mod scheme;
 mod section;
 mod springs;
 mod summary;
+mod superelement;
 
 pub use clearance::{ClearanceData, ContactLaw};
 pub use drive::{Drive, NodeMotion};
@@ -33,6 +34,7 @@ pub use scheme::{Scheme, SchemeNameError};
 pub use section::{BeamProperties, Geometry, Section, SectionData};
 pub use springs::{BushingData, RSpringData, SpringData, SpringLength};
 pub use summary::{Effects, Generated, Summary};
+pub use superelement::SuperelementData;
 
 use indexmap::IndexMap;
 use nalgebra::{Matrix3, Vector3};
@@ -224,6 +226,10 @@ pub enum ElementKind {
     /// A controlled input: a hinge torque or nodal force depending on sensors of the
     /// state ([`control`]); its nodes are the actuator's and the sensors'.
     Control(Box<control::ControlData>),
+    /// A linear elastic body reduced from a finite-element model (Craig–Bampton in a
+    /// floating frame; `crate::elements::superelement`): its nodes are its interface nodes,
+    /// then its generated modal nodes.
+    Superelement(Box<SuperelementData>),
 }
 
 impl ElementKind {
@@ -248,6 +254,7 @@ impl ElementKind {
                 control::ControlLaw::Pid(_) => "PID",
                 _ => "CONTROL",
             },
+            ElementKind::Superelement(_) => "SUPERELEMENT",
         }
     }
 
@@ -261,6 +268,7 @@ impl ElementKind {
             ElementKind::Prismatic { .. } => 5,
             ElementKind::Rigid => 6 * node_count.saturating_sub(1),
             ElementKind::Prescribed { motion, .. } => motion.equations(),
+            ElementKind::Superelement(d) => 6 * d.interface.len().saturating_sub(1),
             _ => 0,
         }
     }

@@ -32,6 +32,8 @@ pub struct Effects {
     pub drivers: bool,
     /// At least one revolute joint with clearance (CLEARANCE).
     pub clearances: bool,
+    /// At least one SUPERELEMENT (a reduced elastic body).
+    pub superelements: bool,
 }
 
 impl Effects {
@@ -51,6 +53,7 @@ impl Effects {
             (self.springs, "springs and dampers"),
             (self.drivers, "drivers"),
             (self.clearances, "clearance joints"),
+            (self.superelements, "superelements"),
         ];
         for (on, name) in list {
             if on {
@@ -146,6 +149,7 @@ impl Model {
                 ElementKind::Prescribed { .. } => e.drivers = true,
                 // A controlled input is an applied load that depends on the state.
                 ElementKind::Control(_) => e.applied_loads = true,
+                ElementKind::Superelement(_) => e.superelements = true,
             }
         }
         e

@@ -204,7 +204,14 @@ fn run_fresh(
     let read = crate::deck::read_source(&plan.deck);
     let text = read.as_deref().unwrap_or_default().to_string();
     let parsed = read.and_then(|t| {
-        crate::deck::parse_deck_with(&t, &plan.deck.display().to_string(), &overrides)
+        crate::deck::parse_deck_with(&t, &plan.deck.display().to_string(), &overrides).map(
+            |mut m| {
+                // A SUPERELEMENT's FILES are relative to the deck's directory.
+                let base = plan.deck.parent().unwrap_or(std::path::Path::new("."));
+                m.resolve_superelement_dirs(base);
+                m
+            },
+        )
     });
     let result = match parsed {
         Err(errs) => Err((app::EXIT_BAD_INPUT, deck_errors_text(&errs))),

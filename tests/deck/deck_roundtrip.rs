@@ -5,16 +5,20 @@ use mecano::deck::{load_deck, parse_deck, strip_spans, write_deck};
 use mecano::model::{ElementKind, Model};
 use std::path::PathBuf;
 
-/// The decks of `decks/` and of `decks/benchmarks/`.
+/// The decks of `decks/`, `decks/benchmarks/` and `decks/superelement/`.
 fn decks() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("decks");
-    let mut v: Vec<PathBuf> = [dir.clone(), dir.join("benchmarks")]
-        .iter()
-        .filter_map(|d| std::fs::read_dir(d).ok())
-        .flatten()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "dat"))
-        .collect();
+    let mut v: Vec<PathBuf> = [
+        dir.clone(),
+        dir.join("benchmarks"),
+        dir.join("superelement"),
+    ]
+    .iter()
+    .filter_map(|d| std::fs::read_dir(d).ok())
+    .flatten()
+    .filter_map(|e| e.ok().map(|e| e.path()))
+    .filter(|p| p.extension().is_some_and(|x| x == "dat"))
+    .collect();
     v.sort();
     v
 }

@@ -36,7 +36,7 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 16] = [
+        const TYPES: [&str; 17] = [
             "BEAM",
             "MASS",
             "HINGE",
@@ -53,6 +53,7 @@ impl Builder<'_> {
             "CONTROL",
             "PRESCRIBED",
             "CLEARANCE",
+            "SUPERELEMENT",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
@@ -256,6 +257,7 @@ impl Builder<'_> {
             "RSPRING" => self.rspring_card(&mut c, id)?,
             "PID" => self.pid_card(&mut c, id)?,
             "CONTROL" => self.control_card(&mut c, id)?,
+            "SUPERELEMENT" => Self::superelement_card(&mut c)?,
             "PRESCRIBED" => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)

@@ -13,6 +13,7 @@ mod nodes;
 mod properties;
 mod section;
 mod springs;
+mod superelement;
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};
@@ -306,6 +307,18 @@ pub(crate) fn build_model(
     // Interior nodes of beams of ORDER p, after the divisions' (model/order.rs). The arcs
     // were validated card by card: this cannot fail on a parsed deck, but says so if it does.
     if let Err(e) = model.raise_orders(&mut numbering) {
+        let err = DeckError::new(
+            K::BadGeneration {
+                first: 0,
+                last: 0,
+                reason: e.to_string(),
+            },
+            Span::default(),
+        );
+        return Err(vec![err]);
+    }
+    // The superelements' modal nodes, past every other number (model/superelement.rs).
+    if let Err(e) = model.add_modal_nodes(&mut numbering) {
         let err = DeckError::new(
             K::BadGeneration {
                 first: 0,

@@ -1,0 +1,470 @@
+//! Superelements (issue 38): the project's own beams exported (`mecano-rs export`), reduced
+//! by Craig–Bampton and run as a `SUPERELEMENT`, against the beam decks they came from
+//! (docs/superelements.md gives the figures these tests print).
+
+mod common;
+
+use mecano::deck::load_deck_with;
+use mecano::elements::superelement::{fe, invariants::Body, reduce};
+use mecano::model::NodeId;
+use mecano::output::History;
+use std::path::Path;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+}
+
+/// The exported bar (decks/superelement/beam/).
+fn beam() -> fe::FeModel {
+    fe::read(&common::root().join("decks/superelement/beam")).expect("the exported bar reads")
+}
+
+/// `mecano-rs export` writes, for decks/superelement/beam_free.dat, the very files kept in
+/// decks/superelement/beam/ (so the decks that read them are the export of today's code).
+#[test]
+fn export_writes_the_kept_files() {
+    let dir = common::TempDir::new("se_export");
+    let out = dir.join("beam");
+    let o = bin()
+        .current_dir(common::root())
+        .args(["export", "decks/superelement/beam_free.dat", "-q", "-o"])
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in fe::FILES {
+        let kept =
+            std::fs::read_to_string(common::root().join("decks/superelement/beam").join(name))
+                .expect("kept");
+        let written = std::fs::read_to_string(out.join(name)).expect("written");
+        assert_eq!(kept, written, "{name} differs from the export");
+    }
+}
+
+/// Eigenvalues of the exported bar, clamped at node 1 and free–free, against its
+/// Craig–Bampton reductions: errors fall as modes are added, 1e-8 with all kept.
+#[test]
+fn reduced_eigenvalues_converge() {
+    let fe = beam();
+    let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
+    let n = fe.dofs.len();
+    let node1: Vec<usize> = (0..6).map(|c| fe.dof_of(1, c).expect("node 1")).collect();
+    let clamped: Vec<usize> = (0..n).filter(|r| !node1.contains(r)).collect();
+    let full_c = reduce::lowest_eigenvalues(&k, &m, &clamped, 6).expect("clamped");
+    let all: Vec<usize> = (0..n).collect();
+    let full_f = reduce::lowest_eigenvalues(&k, &m, &all, 12).expect("free");
+    let rel = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |e, (x, y)| e.max((x - y).abs() / y.abs()))
+    };
+    let (mut last_c, mut last_f) = (f64::INFINITY, f64::INFINITY);
+    for modes in [2, 4, 8, 16, 42] {
+        let red = reduce::reduce(&fe, &k, &m, &[1, 2], modes).expect("reduces");
+        let body = Body::new(&fe, &m, &red, 1, &[2]).expect("mass");
+        let nq = body.n;
+        let mq = body.m0.view((6, 6), (nq, nq)).into_owned();
+        let idx: Vec<usize> = (0..nq).collect();
+        let c = reduce::lowest_eigenvalues(&body.k, &mq, &idx, 6).expect("reduced");
+        let (mm, kk) = body.free_free();
+        let idx: Vec<usize> = (0..6 + nq).collect();
+        let f = reduce::lowest_eigenvalues(&kk, &mm, &idx, 12).expect("reduced");
+        let (ec, ef) = (rel(&c, &full_c), rel(&f[6..], &full_f[6..]));
+        eprintln!(
+            "exported bar, interface nodes 1, 2, {modes:2} modes: clamped 6 lowest ω² {ec:.2e}, free-free 6 lowest elastic ω² {ef:.2e}"
+        );
+        assert!(ec <= last_c * (1.0 + 1e-9) && ef <= last_f * (1.0 + 1e-9));
+        (last_c, last_f) = (ec, ef);
+    }
+    assert!(last_c < 1e-8 && last_f < 1e-8, "{last_c} {last_f}");
+}
+
+/// The `modes` command on the clamped bar as beams and as its superelement (every mode
+/// kept): the same frequencies (the element's linearisation is the reduction's).
+#[test]
+fn modes_of_the_superelement_are_the_beams() {
+    let dir = common::TempDir::new("se_modes");
+    let read = |deck: &str, out: &str, set: &[&str]| -> Vec<f64> {
+        let o = bin()
+            .arg("modes")
+            .arg(common::deck_path(deck))
+            .args(["-q", "--count", "8", "-o"])
+            .arg(dir.join(out))
+            .args(set)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(dir.join(out).join("modes.csv")).expect("modes.csv");
+        text.lines()
+            .skip(1)
+            .map(|l| {
+                l.split(',')
+                    .nth(2)
+                    .expect("frequency")
+                    .parse()
+                    .expect("number")
+            })
+            .collect()
+    };
+    let beams = read("superelement/cantilever_beams.dat", "b", &[]);
+    let all = read("superelement/cantilever_se.dat", "s", &[]);
+    let few = read(
+        "superelement/cantilever_se.dat",
+        "s9",
+        &["--set", "modes=9"],
+    );
+    for i in 0..8 {
+        let e = (all[i] - beams[i]).abs() / beams[i];
+        assert!(e < 1e-8, "mode {}: {} Hz vs {} Hz", i + 1, all[i], beams[i]);
+        // 9 fixed-interface modes of a cantilever clamped at its frame (the 8th and 9th
+        // are a pair of equal frequency, kept whole): its own lowest modes.
+        let e9 = (few[i] - beams[i]).abs() / beams[i];
+        assert!(e9 < 1e-8, "9 modes, mode {}: {e9}", i + 1);
+    }
+}
+
+/// Runs `deck` with the overrides into memory; node `node`'s positions.
+fn positions(deck: &str, set: &[(String, f64)], node: u32) -> (Vec<f64>, Vec<[f64; 3]>) {
+    let model = load_deck_with(&common::deck_path(deck), set).expect("deck");
+    let i = model.nodes.get_index_of(&NodeId(node)).expect("node");
+    let mut h = History::new(1);
+    let report = mecano::solver::run(&model, &mut h).expect("starts");
+    assert!(report.failure.is_none(), "{deck}: {:?}", report.failure);
+    let x = h
+        .nodes
+        .iter()
+        .map(|s| [s[i].x.x, s[i].x.y, s[i].x.z])
+        .collect();
+    (h.t, x)
+}
+
+/// Largest distance between node `node`'s paths in the pendulum as beams and as a
+/// superelement of `modes` modes, at step `h`.
+fn pendulum_difference(modes: u32, h: f64) -> f64 {
+    let hs = ("h".to_string(), h);
+    let (t, full) = positions(
+        "superelement/pendulum_beams.dat",
+        std::slice::from_ref(&hs),
+        2,
+    );
+    let (ts, se) = positions(
+        "superelement/pendulum_se.dat",
+        &[("modes".to_string(), f64::from(modes)), hs],
+        2,
+    );
+    assert_eq!(ts.len(), t.len());
+    full.iter().zip(&se).fold(0.0f64, |m, (a, b)| {
+        m.max(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt())
+    })
+}
+
+/// The flexible pendulum (the bar hinged at one end, 1 kg at the tip, released horizontal
+/// under gravity, 0.4 s): the tip's path as a superelement against the beams', per number
+/// of fixed-interface modes. The difference falls with the modes (0 modes: the Guyan
+/// reduction, the tip's constraint modes alone), then with the step: what remains with
+/// every mode is the two discretisations' time error (the beams' own time error at
+/// h = 1e-3 is 2.2e-5 m against h = 2.5e-4), not the reduction.
+#[test]
+fn flexible_pendulum_converges_with_modes() {
+    let mut last = f64::INFINITY;
+    let mut errs = Vec::new();
+    for modes in [0, 2, 4, 8, 42] {
+        let e = pendulum_difference(modes, 1e-3);
+        eprintln!(
+            "flexible pendulum, h = 1e-3, {modes:2} modes: largest tip distance to the beams over 0.4 s: {e:.3e} m"
+        );
+        errs.push(e);
+        assert!(e <= last * 1.05, "{modes} modes: {e} above {last}");
+        last = last.min(e);
+    }
+    assert!(errs[4] < errs[0] / 5.0 && errs[4] < 1e-5, "{errs:?}");
+    let half = pendulum_difference(42, 5e-4);
+    eprintln!("flexible pendulum, h = 5e-4, 42 modes: {half:.3e} m");
+    assert!(half < errs[4] / 2.0, "{half} against {}", errs[4]);
+}
+
+/// Free flight without gravity or damping: kinetic + strain energy is constant; its drift
+/// is the integrator's, falling with the step as h² (the α = 0 scheme is second order).
+#[test]
+fn free_flight_conserves_energy() {
+    let drift = |h: f64| {
+        let model = load_deck_with(
+            &common::deck_path("superelement/free_flying_se.dat"),
+            &[("h".to_string(), h)],
+        )
+        .expect("deck");
+        let mut hist = History::new(1);
+        let r = mecano::solver::run(&model, &mut hist).expect("starts");
+        assert!(r.failure.is_none());
+        let e0 = hist.energy[0];
+        let d = hist
+            .energy
+            .iter()
+            .fold(0.0f64, |m, e| m.max((e - e0).abs()))
+            / e0;
+        eprintln!("free flight, h = {h:e}: largest relative energy change {d:.3e}");
+        d
+    };
+    let (d1, d2) = (drift(2e-3), drift(1e-3));
+    assert!(d1 < 1e-4 && d2 < d1 / 3.0, "{d1} {d2}");
+}
+
+/// A change made to a copy of the files or the deck.
+type Edit = Box<dyn Fn(&Path)>;
+
+/// Bad input: located errors, exit 2, nothing written.
+#[test]
+fn bad_files_are_refused_located() {
+    let dir = common::TempDir::new("se_bad");
+    let src = common::root().join("decks/superelement");
+    let setup = |name: &str, edit: &dyn Fn(&Path)| -> std::path::PathBuf {
+        let case = dir.join(name);
+        std::fs::create_dir_all(case.join("beam")).expect("dir");
+        for f in fe::FILES {
+            std::fs::copy(src.join("beam").join(f), case.join("beam").join(f)).expect("copy");
+        }
+        std::fs::copy(src.join("pendulum_se.dat"), case.join("d.dat")).expect("copy");
+        edit(&case);
+        case
+    };
+    let replace = |p: std::path::PathBuf, from: &str, to: &str| {
+        let t = std::fs::read_to_string(&p).expect("read");
+        assert!(t.contains(from), "{from}");
+        std::fs::write(&p, t.replacen(from, to, 1)).expect("write");
+    };
+    let cases: Vec<(&str, Edit, &str)> = vec![
+        (
+            "truncated",
+            Box::new(|c: &Path| {
+                let p = c.join("beam/M.mtx");
+                let t = std::fs::read_to_string(&p).expect("read");
+                let cut: Vec<&str> = t.lines().take(10).collect();
+                std::fs::write(&p, cut.join("\n")).expect("write");
+            }),
+            "M.mtx:10:1: truncated",
+        ),
+        (
+            "malformed",
+            Box::new(move |c: &Path| replace(c.join("beam/K.mtx"), "\n13 1 ", "\n13 x ")),
+            "K.mtx:5:4: expected a column index, found `x`",
+        ),
+        (
+            "asymmetric",
+            Box::new(move |c: &Path| {
+                replace(
+                    c.join("beam/K.mtx"),
+                    "coordinate real symmetric",
+                    "coordinate real general",
+                )
+            }),
+            "K.mtx",
+        ),
+        (
+            "wrong_size",
+            Box::new(move |c: &Path| replace(c.join("beam/M.mtx"), "54 54 ", "60 60 ")),
+            "the matrix has 60 rows but the map of degrees of freedom lists 54",
+        ),
+        (
+            "no_node",
+            Box::new(move |c: &Path| {
+                replace(c.join("d.dat"), "INTERFACE 1 1 2 2", "INTERFACE 1 1 77 2")
+            }),
+            "interface node 77",
+        ),
+        (
+            "too_many_modes",
+            Box::new(move |c: &Path| replace(c.join("d.dat"), "modes 4", "modes 43")),
+            "MODES 43: the FE model has 42 interior",
+        ),
+        (
+            "no_files",
+            Box::new(move |c: &Path| replace(c.join("d.dat"), "FILES beam", "FILES nowhere")),
+            "nodes.csv:0:0: cannot read",
+        ),
+        (
+            "misplaced",
+            Box::new(move |c: &Path| replace(c.join("d.dat"), "  2 1 0 0\n", "  2 1.1 0 0\n")),
+            "FE interface node 2 (node 2) is at",
+        ),
+    ];
+    for (name, edit, expect) in cases {
+        let case = setup(name, &*edit);
+        let o = bin()
+            .arg(case.join("d.dat"))
+            .args(["-q", "-o"])
+            .arg(case.join("out"))
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(expect), "{name}: `{expect}` not in: {err}");
+        // Placed at the SUPERELEMENT card (line 15, column 3 of pendulum_se.dat).
+        assert!(
+            err.contains("d.dat: line 15:3: element 2: SUPERELEMENT"),
+            "{name}: {err}"
+        );
+        assert!(
+            !case.join("out").exists(),
+            "{name}: wrote its output directory"
+        );
+    }
+}
+
+/// Kane's spin-up beam's tip deflection in the rotating frame (node 2's rotation), at
+/// every recorded time.
+fn spinup_deflection(deck: &str, set: &[(String, f64)]) -> Vec<f64> {
+    let model = load_deck_with(&common::deck_path(deck), set).expect("deck");
+    let (i2, i3) = (
+        model.nodes.get_index_of(&NodeId(2)).expect("hub"),
+        model.nodes.get_index_of(&NodeId(3)).expect("tip"),
+    );
+    let mut h = History::new(1);
+    let report = mecano::solver::run(&model, &mut h).expect("starts");
+    assert!(report.failure.is_none(), "{deck}: {:?}", report.failure);
+    h.nodes
+        .iter()
+        .map(|s| (s[i2].r.transpose() * (s[i3].x - s[i2].x)).y)
+        .collect()
+}
+
+/// Kane's spin-up beam (decks/benchmarks/spinup.dat) at low hub rates, as beams and as a
+/// superelement of its exported matrices (8 modes): the floating frame keeps every
+/// inertia coupling but, its body being linear, not the centrifugal stiffening of the
+/// beams, whose share of the tip's deflection is `(ω_s/ω₁)²` (ω₁ = 3.80 rad/s, the first
+/// bending frequency): the difference stays below it and grows as `ω_s²`.
+#[test]
+fn spin_up_at_low_rates_within_the_missing_stiffening() {
+    let w1: f64 = 3.7977;
+    let mut rel = Vec::new();
+    for ws in [0.5, 1.0] {
+        let set = [("ws".to_string(), ws), ("tend".to_string(), 16.0)];
+        let beams = spinup_deflection("benchmarks/spinup.dat", &set);
+        let se = spinup_deflection("superelement/spinup_se.dat", &set);
+        assert_eq!(beams.len(), se.len());
+        let peak = beams.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = beams
+            .iter()
+            .zip(&se)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let r = diff / peak;
+        eprintln!(
+            "spin-up, ws = {ws}: tip deflection peak {peak:.4e} m, largest difference {diff:.3e} m ({r:.2e} of the peak; (ws/w1)^2 = {:.2e})",
+            (ws / w1).powi(2)
+        );
+        assert!(r < (ws / w1).powi(2), "ws {ws}: {r}");
+        rel.push(r);
+    }
+    let growth = rel[1] / rel[0];
+    assert!(
+        (2.5..6.0).contains(&growth),
+        "growth {growth} for twice the rate"
+    );
+}
+
+/// Objectivity of the whole chain: the free-flying bar's FE model and initial velocities
+/// rotated by `Q` (nodes, `K` and `M` transformed dof block by dof block) give the
+/// rotated trajectory of the frame node and the same energies, to round-off amplified by
+/// the run (the step and Newton's tolerance are the same in both).
+#[test]
+fn a_rotated_fe_model_gives_the_rotated_motion() {
+    use nalgebra::{DMatrix, Vector3};
+    let q = mecano::rotation::exp(&Vector3::new(0.3, -0.8, 1.1));
+    let fe0 = beam();
+    let n = fe0.dofs.len();
+    let mut t = DMatrix::zeros(n, n);
+    for (r, &(p, c)) in fe0.dofs.iter().enumerate() {
+        let base = 3 * (c as usize / 3);
+        for k in 0..3 {
+            let col = fe0.dof_of(p, (base + k) as u8).expect("six dofs");
+            t[(r, col)] = q[(c as usize % 3, k)];
+        }
+    }
+    let dir = common::TempDir::new("se_rotated");
+    let fe_dir = dir.join("beam");
+    std::fs::create_dir_all(&fe_dir).expect("dir");
+    let k = &t * fe0.k.to_dense() * t.transpose();
+    let m = &t * fe0.m.to_dense() * t.transpose();
+    let sym = mecano::elements::superelement::mtx::SymMatrix::from_dense;
+    std::fs::write(fe_dir.join("K.mtx"), sym(&k, 1e-15).to_text("rotated")).expect("K");
+    std::fs::write(fe_dir.join("M.mtx"), sym(&m, 1e-15).to_text("rotated")).expect("M");
+    let nodes: Vec<(u32, Vector3<f64>)> = fe0.nodes.iter().map(|(p, x)| (*p, q * x)).collect();
+    std::fs::write(fe_dir.join("nodes.csv"), fe::nodes_text(&nodes)).expect("nodes");
+    std::fs::write(fe_dir.join("dofs.csv"), fe::dofs_text(&fe0.dofs)).expect("dofs");
+    let text = std::fs::read_to_string(common::deck_path("superelement/free_flying_se.dat"))
+        .expect("deck");
+    let (v, w) = (
+        q * Vector3::new(0.5, 0.0, 0.0),
+        q * Vector3::new(3.0, 0.0, 6.0),
+    );
+    let rotated = text.replace(
+        "  1 V 0.5 0 0 W 3 0 6",
+        &format!(
+            "  1 V {:?} {:?} {:?} W {:?} {:?} {:?}",
+            v.x, v.y, v.z, w.x, w.y, w.z
+        ),
+    );
+    assert_ne!(rotated, text);
+    std::fs::write(dir.join("rotated.dat"), rotated).expect("deck");
+    let run = |path: &Path| {
+        let model = mecano::deck::load_deck(path).expect("deck");
+        let i = model.nodes.get_index_of(&NodeId(1)).expect("node 1");
+        let mut h = History::new(1);
+        let r = mecano::solver::run(&model, &mut h).expect("starts");
+        assert!(r.failure.is_none());
+        let x: Vec<Vector3<f64>> = h.nodes.iter().map(|s| s[i].x).collect();
+        (x, h.energy)
+    };
+    let (x0, e0) = run(&common::deck_path("superelement/free_flying_se.dat"));
+    let (x1, e1) = run(&dir.join("rotated.dat"));
+    let dx = x0
+        .iter()
+        .zip(&x1)
+        .fold(0.0f64, |m, (a, b)| m.max((q * a - b).norm()));
+    let de = e0
+        .iter()
+        .zip(&e1)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / a.abs()));
+    eprintln!(
+        "rotated FE model: frame node off the rotated path by {dx:.2e} m, energies by {de:.2e}"
+    );
+    assert!(dx < 1e-8 && de < 1e-10, "{dx} {de}");
+}
+
+/// Every integrator advances the superelement unchanged (its coordinates are nodes): the
+/// flexible pendulum (8 modes) under generalized-α, ESDIRK3 and ESDIRK5 against the
+/// beams under the same scheme, within the HHT figure of
+/// `flexible_pendulum_converges_with_modes` (3.4e-6 m at h = 1e-3).
+#[test]
+fn every_integrator_runs_the_superelement() {
+    let dir = common::TempDir::new("se_schemes");
+    let src = common::root().join("decks/superelement");
+    std::fs::create_dir_all(dir.join("beam")).expect("dir");
+    for f in fe::FILES {
+        std::fs::copy(src.join("beam").join(f), dir.join("beam").join(f)).expect("copy");
+    }
+    for scheme in ["GENALPHA RHOINF 0.8", "ESDIRK3", "ESDIRK5"] {
+        let mut tips = Vec::new();
+        for deck in ["pendulum_beams.dat", "pendulum_se.dat"] {
+            let text = std::fs::read_to_string(src.join(deck)).expect("deck");
+            let text = text
+                .replace("ALPHA 0 STEP", &format!("{scheme} STEP"))
+                .replace("  modes 4\n", "  modes 8\n");
+            let path = dir.join(deck);
+            std::fs::write(&path, text).expect("write");
+            let model = mecano::deck::load_deck(&path).expect("deck");
+            let i = model.nodes.get_index_of(&NodeId(2)).expect("tip");
+            let mut h = History::new(1);
+            let r = mecano::solver::run(&model, &mut h).expect("starts");
+            assert!(r.failure.is_none(), "{scheme} {deck}: {:?}", r.failure);
+            tips.push(h.nodes.iter().map(|s| s[i].x).collect::<Vec<_>>());
+        }
+        assert_eq!(tips[0].len(), tips[1].len());
+        let d = tips[0]
+            .iter()
+            .zip(&tips[1])
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).norm()));
+        eprintln!("{scheme}: largest tip distance, superelement (8 modes) to beams: {d:.2e} m");
+        assert!(d < 4e-6, "{scheme}: {d}");
+    }
+}
