@@ -58,10 +58,8 @@ impl Integrator {
         } else {
             0.0
         };
-        for (s, t) in self.nodes.iter_mut().zip(&self.trial) {
-            *s = *t;
-            s.r = rotation::orthonormalize(&s.r);
-        }
+        // (The trial's rotations were re-orthonormalized by `finish_step`, before the guard.)
+        self.nodes.copy_from_slice(&self.trial);
         if self.dynamic {
             self.pseudo.copy_from_slice(&self.trial_pseudo);
         }

@@ -436,6 +436,12 @@ impl Integrator {
             history = kept;
             next_cap = Some(next);
         }
+        // The rotations as they will be accepted (re-orthonormalized), before the guard
+        // measures the state: its measure is kept for the next step, and a restart measures
+        // the accepted state afresh — both must see the same bits (tests/cli_io/restart.rs).
+        for t in &mut self.trial {
+            t.r = crate::rotation::orthonormalize(&t.r);
+        }
         // A converged state must not hold energy the step (or the run of steps it ends)
         // cannot pay for.
         let passed = if self.dynamic {
