@@ -306,28 +306,23 @@ pub(crate) fn build_model(
     let mut numbering = crate::model::Numbering::after(&model);
     // Interior nodes of beams of ORDER p, after the divisions' (model/order.rs). The arcs
     // were validated card by card: this cannot fail on a parsed deck, but says so if it does.
-    if let Err(e) = model.raise_orders(&mut numbering) {
-        let err = DeckError::new(
+    // A generation that fails on a parsed deck has no card to point at.
+    let unplaced = |reason: String| {
+        vec![DeckError::new(
             K::BadGeneration {
                 first: 0,
                 last: 0,
-                reason: e.to_string(),
+                reason,
             },
             Span::default(),
-        );
-        return Err(vec![err]);
-    }
+        )]
+    };
+    model
+        .raise_orders(&mut numbering)
+        .map_err(|e| unplaced(e.to_string()))?;
     // The superelements' modal nodes, past every other number (model/superelement.rs).
-    if let Err(e) = model.add_modal_nodes(&mut numbering) {
-        let err = DeckError::new(
-            K::BadGeneration {
-                first: 0,
-                last: 0,
-                reason: e.to_string(),
-            },
-            Span::default(),
-        );
-        return Err(vec![err]);
-    }
+    model
+        .add_modal_nodes(&mut numbering)
+        .map_err(|e| unplaced(e.to_string()))?;
     Ok(model)
 }
