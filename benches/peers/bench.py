@@ -1,21 +1,23 @@
 #!/usr/bin/env python3
 """Work-precision of mecano-rs and its peers on the same scenes (benches/peers/README.md).
 
-    python3 benches/peers/bench.py [--out out/peers] [--scenes a,b] [--codes mecano,exudyn,mbdyn]
+    python3 benches/peers/bench.py [--out out/peers] [--scenes a,b] [--codes mecano-rs,exudyn,mbdyn]
                                    [--rounds R] [--quick]
 
 For each scene: a converged reference (mecano-rs on a mesh and step finer than any run, with
 a second, coarser run that bounds its own error), then each code's ladder of meshes and
 steps, run one after the other on this machine; every run's error is the largest distance of
 the scene's compared quantities from the reference (interpolated at the run's output instants
-by cubic Hermite on positions and velocities), its CPU: for mecano-rs the user + system
-seconds of its whole process (parsing, the start's modal summary and the output included:
-getrusage of the child), for Exudyn the process seconds of its solve alone
-(time.process_time around SolveSteps: Python's start, the imports and the model's building
-excluded), so that a ratio of the two understates mecano-rs's lead; best of --rounds. Writes OUT/runs.jsonl (one line per run), OUT/tables.md (the tables of
-docs/performance.md), OUT/<scene>.png/.svg (error against CPU, log-log) and prints the tables.
-A code that is not installed or whose run fails is reported in the table and the bench goes on.
-Standard library for the runs and tables; matplotlib for the figures, if importable.
+by cubic Hermite on positions and velocities), its CPU: for mecano-rs and MBDyn the user +
+system seconds of the whole process (parsing, the start and the output included: getrusage
+of the child), for Exudyn the process seconds of its solve alone (time.process_time around
+SolveSteps: Python's start, the imports and the model's building excluded), so that a ratio
+of mecano-rs to Exudyn understates mecano-rs's lead; best of --rounds. Writes OUT/runs.jsonl
+(one line per run, the machine's first), OUT/tables.md (the tables of docs/performance.md),
+OUT/<scene>.png/.svg (error against CPU, log-log) and prints the tables. A code that is not
+installed (OUT/status/<code>.fail, written by install.sh) or whose run fails is reported in
+the table and the bench goes on. Standard library for the runs and tables; matplotlib for the
+figures, if importable.
 """
 import argparse
 import bisect
@@ -34,7 +36,7 @@ PEERS = os.path.join(ROOT, "benches", "peers")
 BIN = os.path.join(ROOT, "target", "release", "mecano-rs")
 VENV_PY = os.path.join(PEERS, ".venv", "bin", "python")
 sys.path.insert(0, PEERS)
-from scenes import SCENES, deck_text  # noqa: E402
+from scenes import PEER_SCENES, SCENES, deck_text  # noqa: E402
 
 
 # ------------------------------------------------------------------------- reading runs
@@ -187,26 +189,65 @@ def children_cpu():
     return r.ru_utime + r.ru_stime
 
 
-def run_exudyn(scene, n, h, out):
+PEERS_RUN = {
+    # code: (the Python that runs its script, the script, the mesh's words, the scheme)
+    "exudyn": (VENV_PY, "exudyn_scenes.py", "two-node", lambda scene: "HHT -0.1" if scene == "pendulum"
+               else "generalized-alpha"),
+    "mbdyn": (sys.executable, "mbdyn_scenes.py", "beam3", lambda scene: "ms 0.9"),
+}
+
+
+def run_peer(code, scene, n, h, out):
+    """Runs a peer's configuration (n elements per bar/leg/beam/rod, step h) through its script;
+    returns its record (no error yet)."""
+    py, script, words, scheme = PEERS_RUN[code]
     os.makedirs(out, exist_ok=True)
     csvp = os.path.join(out, "run.csv")
-    p = subprocess.run([VENV_PY, os.path.join(PEERS, "exudyn_scenes.py"), scene,
-                        "--h", repr(h), "--n", str(n), "--out", csvp], capture_output=True, text=True)
-    rec = dict(code="exudyn", scene=scene, label=f"{n} beams, h = {h:g}", h=h, mesh=f"{n} two-node",
-               scheme="generalized-alpha" if scene != "pendulum" else "HHT -0.1")
+    if os.path.exists(csvp):
+        os.remove(csvp)
+    p = subprocess.run([py, os.path.join(PEERS, script), scene, "--h", repr(h), "--n", str(n), "--out", csvp],
+                       capture_output=True, text=True)
+    rec = dict(code=code, scene=scene, label=f"{n} {words} per {SCENES[scene]['per']}, {scheme(scene)}, h = {h:g}",
+               h=h, mesh=f"{n} {words}", scheme=scheme(scene))
+    j = {}
     try:
         j = json.loads(p.stdout.strip().splitlines()[-1])
-        rec.update(ok=j["ok"], cpu=j["cpu"], steps=j["steps"], newton=j["newton"], factorisations=j["jacobians"],
-                   version=j["version"])
+        rec.update(ok=j["ok"], cpu=j["cpu"], steps=j["steps"], newton=j["newton"],
+                   factorisations=j.get("jacobians"), version=j.get("version"))
     except (IndexError, ValueError, KeyError):
         rec.update(ok=False, cpu=None, steps=None, newton=None)
     if not rec["ok"]:
-        if rec.get("steps") is not None:
-            rec["why"] = f"Exudyn stopped at t = {j['t_reached']:.4g} s (Newton did not converge; fixed step)"
+        if j.get("why"):
+            rec["why"] = j["why"]
+        elif rec.get("steps") is not None and j.get("t_reached") is not None:
+            rec["why"] = f"stopped at t = {j['t_reached']:.4g} s (Newton did not converge; fixed step)"
         else:
             rec["why"] = ((p.stderr or p.stdout).strip().splitlines() or ["failed"])[-1][:200]
     rec["csv"] = csvp
     return rec
+
+
+def machine():
+    """The machine and the codes' versions, for the tables' header."""
+    def sh(*cmd):
+        try:
+            return subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT).stdout
+        except OSError:
+            return ""
+    cpu = {}
+    for line in sh("lscpu").splitlines():
+        k, _, v = line.partition(":")
+        cpu[k.strip()] = v.strip()
+    mem = next((line.split()[1] for line in open("/proc/meminfo") if line.startswith("MemTotal")), "?") \
+        if os.path.exists("/proc/meminfo") else "?"
+    return dict(code="machine", scene="*",
+                cpu=f"{cpu.get('Model name', '?')}, {cpu.get('CPU(s)', '?')} CPUs "
+                    f"({cpu.get('Thread(s) per core', '?')} thread per core), L2 {cpu.get('L2 cache', '?')}, "
+                    f"L3 {cpu.get('L3 cache', '?')}, {cpu.get('Hypervisor vendor', 'no')} hypervisor",
+                memory_gib=round(int(mem) / 2**20, 1) if mem != "?" else None,
+                mecano_commit=sh("git", "rev-parse", "--short", "HEAD").strip(),
+                python=sys.version.split()[0],
+                load=open("/proc/loadavg").read().split()[:3] if os.path.exists("/proc/loadavg") else None)
 
 
 def peer_status(out):
@@ -226,7 +267,8 @@ def peer_status(out):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "peers"))
-    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--scenes", default=",".join(PEER_SCENES),
+                    help=f"default: the scenes the peers model; also: {', '.join(s for s in SCENES if s not in PEER_SCENES)}")
     ap.add_argument("--codes", default="mecano-rs,exudyn,mbdyn")
     ap.add_argument("--rounds", type=int, default=1, help="timed runs per configuration (best of)")
     ap.add_argument("--quick", action="store_true", help="only each code's cheapest two configurations")
@@ -234,7 +276,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     status = peer_status(a.out)
     codes = a.codes.split(",")
-    records = []
+    records = [machine()]
     for scene in a.scenes.split(","):
         sc = SCENES[scene]
         sd = os.path.join(a.out, scene)
@@ -280,7 +322,7 @@ def main():
                     if code == "mecano-rs":
                         r = run_mecano(scene, cfg, d)
                     else:
-                        r = run_exudyn(scene, cfg[0], cfg[1], d)
+                        r = run_peer(code, scene, cfg[0], cfg[1], d)
                     if best is None or (r["ok"] and best["ok"] and r["cpu"] < best["cpu"]):
                         best = r if best is None or r["ok"] else best
                     if not r["ok"]:

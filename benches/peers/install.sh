@@ -36,7 +36,8 @@ else
   rm -f "$log"
 fi
 
-# --- MBDyn
+# --- MBDyn (a build from source: tens of minutes on two cores the first time)
+[ -x benches/peers/.mbdyn/bin/mbdyn ] || echo "peers: building MBDyn from its source (benches/peers/install_mbdyn.sh; tens of minutes the first time) ..."
 if msg=$(bash benches/peers/install_mbdyn.sh 2>&1 | tail -1) && [ -x benches/peers/.mbdyn/bin/mbdyn ]; then
   ok mbdyn "$msg"
 else

@@ -83,12 +83,14 @@ def bar4(h, d, p, scheme, label=None):
     return mk(label, h, d, p, scheme, 2, " per bar")
 
 
-# The ladders. mecano-rs: (label, h, divisions, order, ANALYSIS scheme); Exudyn: (beams per
-# bar/leg/beam/rod, h). The first mecano-rs rung of each scene is the deck as shipped.
+# The ladders. mecano-rs: (label, h, divisions, order, ANALYSIS scheme); Exudyn: (two-node
+# beams per bar/leg/beam/rod, h); MBDyn: (three-node beam3 per leg/beam/rod, h). The first
+# mecano-rs rung of each scene is the deck as shipped. PEER_SCENES: the scenes a peer models,
+# the bench's default.
 SCENES = {
     "pendulum": dict(
         title="seed's double pendulum striking the floor (flexible1), t <= 1.5 s, nodes 12 and 23",
-        deck="decks/pendulum_converged.dat", mesh_re=r"ORDER 8", tend=1.5, period=1e-3,
+        per="bar", deck="decks/pendulum_converged.dat", mesh_re=r"ORDER 8", tend=1.5, period=1e-3,
         nodes=[12, 23], widths=[3, 3], channels=positions([12, 23]), target=1e-3,
         ref=pend(3.90625e-5, 2, 8, "ESDIRK5", "reference: 2 x order 8 per bar, ESDIRK5, h = 3.90625e-5"),
         check=pend(7.8125e-5, 2, 8, "ESDIRK5", "check: 2 x order 8 per bar, ESDIRK5, h = 7.8125e-5"),
@@ -100,11 +102,11 @@ SCENES = {
                 pend(1.953125e-4, 1, 10, "ESDIRK5"),
                 pend(3.90625e-4, 2, 8, "ESDIRK5"),
                 pend(1.5625e-5, 1, 8, "ALPHA -0.1")],
-        exudyn=[(10, 1e-4), (10, 5e-5), (20, 5e-5), (40, 5e-5), (40, 2.5e-5)],
+        exudyn=[(10, 1e-4), (20, 1e-4), (20, 5e-5), (40, 5e-5), (40, 2.5e-5)],
     ),
     "cantilever": dict(
         title="right-angle cantilever (Simo & Vu-Quoc 1988), t <= 30 s, elbow and tip",
-        deck="decks/benchmarks/right_angle_cantilever.dat", mesh_re=r"DIVIDE \$n", tend=30.0, period=0.1,
+        per="leg", deck="decks/benchmarks/right_angle_cantilever.dat", mesh_re=r"DIVIDE \$n", tend=30.0, period=0.1,
         nodes=[2, 3], widths=[3, 3], channels=positions([2, 3]),
         ref=leg(0.0125, 4, 8, "ESDIRK5", "reference: 4 x order 8 per leg, ESDIRK5, h = 0.0125"),
         check=leg(0.025, 2, 8, "ESDIRK5", "check: 2 x order 8 per leg, ESDIRK5, h = 0.025"),
@@ -119,12 +121,15 @@ SCENES = {
                 leg(0.1, 2, 6, "ESDIRK5"),
                 leg(0.05, 2, 6, "ESDIRK5"),
                 leg(0.025, 1, 6, "ALPHA 0"),
-                leg(0.0375, 1, 6, "ALPHA 0")],
-        exudyn=[(10, 0.05), (20, 0.05), (40, 0.05), (40, 0.025), (80, 0.025), (80, 0.0125)],
+                leg(0.0375, 1, 6, "ALPHA 0"),
+                leg(0.025, 1, 4, "ALPHA 0"),
+                leg(0.025, 1, 5, "ALPHA 0")],
+        exudyn=[(10, 0.05), (20, 0.05), (20, 0.025), (40, 0.05), (40, 0.025), (80, 0.0125)],
+        mbdyn=[(5, 0.05), (10, 0.025), (10, 0.0125), (20, 0.025), (20, 0.0125), (40, 0.0125)],
     ),
     "spinup": dict(
         title="Kane's spin-up beam, omega_s = 4 rad/s, t <= 20 s, tip deflection in the rotating frame",
-        deck="decks/benchmarks/spinup.dat", mesh_re=r"DIVIDE \$n", tend=20.0, period=0.1,
+        per="beam", deck="decks/benchmarks/spinup.dat", mesh_re=r"DIVIDE \$n", tend=20.0, period=0.1,
         nodes=[3], widths=[1], channels=spinup_v,
         ref=mk("reference: 4 x order 8, ESDIRK5, h = 2.5e-3", 2.5e-3, 4, 8, "ESDIRK5"),
         check=mk("check: 2 x order 8, ESDIRK5, h = 5e-3", 5e-3, 2, 8, "ESDIRK5"),
@@ -140,12 +145,15 @@ SCENES = {
                 mk(None, 0.04, 3, 6, "ESDIRK5"),
                 mk(None, 0.02, 3, 6, "ESDIRK5"),
                 mk(None, 0.04, 2, 8, "ESDIRK5"),
-                mk(None, 0.02, 2, 8, "ESDIRK5")],
-        exudyn=[(10, 0.01), (20, 0.01), (20, 0.005), (40, 0.005), (80, 0.0025)],
+                mk(None, 0.02, 2, 8, "ESDIRK5"),
+                mk(None, 0.0125, 1, 4, "ALPHA -0.05"),
+                mk(None, 0.01, 1, 3, "ALPHA -0.05")],
+        exudyn=[(10, 0.01), (20, 0.02), (20, 0.0125), (20, 0.01), (40, 0.005), (80, 0.0025)],
+        mbdyn=[(5, 0.01), (10, 0.01), (10, 0.005), (20, 0.005), (40, 0.0025)],
     ),
     "slider_crank": dict(
         title="flexible slider-crank (Song & Haug 1980), t <= 0.06 s, the rod's mid-span deflection",
-        deck="decks/benchmarks/slider_crank_flexible.dat", mesh_re=r"ORDER 4", tend=0.06, period=1e-4,
+        per="rod", deck="decks/benchmarks/slider_crank_flexible.dat", mesh_re=r"ORDER 4", tend=0.06, period=1e-4,
         nodes=[10, 12, 14], widths=[1], channels=midspan_w,
         ref=rod(2.5e-6, 2, 8, "ESDIRK5", "reference: 8 x order 8 in the rod, ESDIRK5, h = 2.5e-6"),
         check=rod(5e-6, 1, 8, "ESDIRK5", "check: 4 x order 8 in the rod, ESDIRK5, h = 5e-6"),
@@ -159,7 +167,8 @@ SCENES = {
                 rod(4e-5, 1, 4, "ALPHA 0"),
                 rod(1.6e-4, 1, 3, "ESDIRK5"),
                 rod(2.4e-4, 1, 4, "ESDIRK5")],
-        exudyn=[(8, 1e-5), (16, 1e-5), (32, 1e-5), (32, 5e-6), (64, 5e-6), (128, 2.5e-6)],
+        exudyn=[(8, 1e-5), (16, 1e-5), (32, 1e-5), (64, 1e-5), (128, 1e-5), (128, 5e-6), (256, 5e-6)],
+        mbdyn=[(4, 1e-5), (8, 1e-5), (16, 1e-5), (32, 1e-5), (32, 5e-6)],
     ),
     "four_bar": dict(
         title="Bauchau's spatial four-bar, t <= 2.5 s (before the first flattened position), "
@@ -204,6 +213,9 @@ SCENES = {
                 mk(None, 1e-5, 1, 1, "ESDIRK5")],
     ),
 }
+
+
+PEER_SCENES = ["pendulum", "cantilever", "spinup", "slider_crank"]
 
 
 def deck_text(scene, cfg, dense=False):

@@ -33,7 +33,8 @@ def scene_report(scene, recs):
         if not r.get("ok"):
             out.append(f"| {r['code']} | {r.get('label', '-')} | | | | | failed or missing: {r.get('why', '?')} | |")
             continue
-        out.append(f"| {r['code']} | {r['label']} | {r['steps']:,} | {r['newton']:,} | {r.get('factorisations') or 0:,} "
+        fac = r.get("factorisations")
+        out.append(f"| {r['code']} | {r['label']} | {r['steps']:,} | {r['newton']:,} | {'–' if fac is None else f'{fac:,}'} "
                    f"| {r['cpu']:.3f} | {r['error']:.2e} | {r['error'] / target:.2f} |")
     out.append("")
     mec = [r for r in recs if r["code"] == "mecano-rs"]
@@ -91,7 +92,12 @@ def figure(scene, recs, out):
 
 
 def report(records, out):
-    text = []
+    m = next((r for r in records if r["code"] == "machine"), None)
+    text = [f"Machine: {m['cpu']}, {m['memory_gib']} GiB; mecano-rs {m['mecano_commit']}, Python {m['python']}; "
+            f"load average at the start {' '.join(m['load'] or [])}.", ""] if m else []
+    versions = sorted({f"{r['code']} {r['version']}" for r in records if r.get("version")})
+    if versions:
+        text += ["Peers: " + ", ".join(versions) + ".", ""]
     drawn = []
     for scene in SCENES:
         recs = [r for r in records if r["scene"] == scene]
