@@ -78,5 +78,8 @@ make install DESTDIR="$work/stage" >"$logs/install.log" 2>&1 ||
   { echo "MBDyn's make install failed: $(tail -1 "$logs/install.log")"; exit 1; }
 LD_LIBRARY_PATH="$work/stage$dest/lib" "$work/stage$dest/bin/mbdyn" --version >"$logs/version.log" 2>&1 ||
   { echo "the MBDyn just built does not run: $(tail -1 "$logs/version.log")"; exit 1; }
+# (one of MBDyn's Makefiles, build/, makes an empty $dest/libexec ignoring DESTDIR: no
+# binary is there, the check at the top said so, so the folder is replaced whole)
+rm -rf "$dest"
 mv "$work/stage$dest" "$dest"
 echo "mbdyn built in $dest from $what ($(grep -m1 -i 'mbdyn' "$logs/version.log" || echo '?'))"

@@ -102,7 +102,7 @@ SCENES = {
                 pend(1.953125e-4, 1, 10, "ESDIRK5"),
                 pend(3.90625e-4, 2, 8, "ESDIRK5"),
                 pend(1.5625e-5, 1, 8, "ALPHA -0.1")],
-        exudyn=[(10, 1e-4), (20, 1e-4), (20, 5e-5), (40, 5e-5), (40, 2.5e-5)],
+        exudyn=[(10, 1e-4), (20, 1e-4), (40, 5e-5), (80, 5e-5)],
     ),
     "cantilever": dict(
         title="right-angle cantilever (Simo & Vu-Quoc 1988), t <= 30 s, elbow and tip",

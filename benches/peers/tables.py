@@ -79,7 +79,7 @@ def figure(scene, recs, out):
         if pts:
             ax.loglog([p[0] for p in pts], [p[1] for p in pts], marks.get(code, "x"), label=code)
     ax.axhline(ref["target"], color="grey", ls="--", lw=1, label="1e-3 of the motion")
-    ax.set_xlabel("CPU s (solve)")
+    ax.set_xlabel("CPU s (mecano-rs, MBDyn: the whole process; Exudyn: its solve)")
     ax.set_ylabel("largest error against the reference")
     ax.set_title(scene)
     ax.grid(True, which="both", alpha=0.3)
