@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
 """Where a run's CPU goes, by phase (issue 37 item 4; docs/performance.md, "Where the CPU goes").
 
-    python3 benches/profile.py DECK|SCENE:RUNG [...] [--freq 999] [--set name=value] [--out DIR]
+    python3 benches/profile.py DECK|SCENE:RUNG [...] [--samples 3000] [--set name=value] [--out DIR]
 
 SCENE:RUNG names a configuration of the peer bench's mecano-rs ladder (benches/peers/scenes.py,
 counted from 0; e.g. cantilever:13, the cheapest at the target in docs/performance.md), the
 deck made as bench.py makes it.
 
-Runs target/release/mecano-rs on each deck under Linux `perf record` (sampling at --freq Hz,
-call stacks unwound with DWARF: the release profile keeps its debug info), then gives each
+Runs target/release/mecano-rs on each deck once plainly (to time it), then under Linux
+`perf record` at the frequency that gives about --samples samples (500 to 20,000 Hz; call
+stacks unwound with DWARF: the release profile keeps its debug info), then gives each
 sample to the phase of the innermost function on its stack that names one (the table
 PHASES below, first match from the leaf up): residual (the elements' and the loads' forces,
 the assembly of the right-hand side), tangent (the elements' tangent matrices and their
@@ -20,7 +21,10 @@ restarts), output (histories, summary, checkpoints), start (reading the deck, bu
 model and the system, the initial accelerations) and other. No instrumentation: the binary
 measured is the release build as shipped, its hot loop unchanged. A sample whose stack
 DWARF unwinding cut short before any phase's function is counted as "unattributed" (the
-table gives its share: the phases' shares are of the attributed samples).
+table gives its share: the phases' shares are of the attributed samples). Elements that
+compute their forces and their tangent in one function (joints, rigid bodies, contacts) count
+whole as residual; the beams' tangents (internal_tangent) and the assembly of the rotation
+tangent maps count as tangent.
 
 Needs `perf` (Debian: linux-perf) and the right to sample one's own processes
 (/proc/sys/kernel/perf_event_paranoid <= 2). Not part of CI.
@@ -98,11 +102,16 @@ def resolve(arg, workdir):
     return path, f"{scene}: {cfg['label']}"
 
 
-def profile(arg, freq, workdir, extra):
+def profile(arg, target, workdir, extra):
     deck, name = resolve(arg, workdir)
     data = os.path.join(workdir, "perf.data")
     outdir = os.path.join(workdir, "run")
-    p = subprocess.run(["perf", "record", "-q", "-F", str(freq), "--call-graph", "dwarf,32768", "-o", data, BIN,
+    t0 = os.times()
+    subprocess.run([BIN, deck, "-o", outdir, "--quiet", "--checkpoint", "0", "--force", *extra], capture_output=True)
+    t1 = os.times()
+    cpu = (t1.children_user - t0.children_user) + (t1.children_system - t0.children_system)
+    freq = int(min(20000, max(500, target / max(cpu, 1e-3))))
+    p = subprocess.run(["perf", "record", "-q", "-F", str(freq), "--call-graph", "dwarf,16384", "-o", data, BIN,
                         deck, "-o", outdir, "--quiet", "--checkpoint", "0", "--force", *extra],
                        capture_output=True, text=True)
     if p.returncode != 0:
@@ -115,7 +124,7 @@ def profile(arg, freq, workdir, extra):
     counts = {p: phases.count(p) for p in ORDER}
     attributed = n - counts["unattributed"]
     st = s["stats"]
-    return dict(deck=name, samples=n, attributed=attributed, counts=counts,
+    return dict(deck=name, samples=n, freq=freq, process_cpu=cpu, attributed=attributed, counts=counts,
                 integration_seconds=st["cpu_seconds"], steps=st["steps"], newton=st["newton_iterations"],
                 factorisations=st["factorizations"])
 
@@ -131,15 +140,15 @@ def markdown(results):
     lines.append("| samples | " + " | ".join(f"{r['samples']:,}" for r in results) + " |")
     lines.append("| steps / Newton / factorisations | " + " | ".join(
         f"{r['steps']:,} / {r['newton']:,} / {r['factorisations']:,}" for r in results) + " |")
-    lines.append("| integration's wall s (summary.json) | " + " | ".join(
-        f"{r['integration_seconds']:.2f}" for r in results) + " |")
+    lines.append("| CPU s of the process, unprofiled | " + " | ".join(
+        f"{r['process_cpu']:.3f}" for r in results) + " |")
     return "\n".join(lines)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("decks", nargs="+")
-    ap.add_argument("--freq", type=int, default=999)
+    ap.add_argument("--samples", type=int, default=3000, help="about this many samples per deck")
     ap.add_argument("--set", action="append", default=[], help="passed to mecano-rs (--set name=value)")
     ap.add_argument("--out", help="keep the perf data and runs here (default: a temporary folder)")
     a = ap.parse_args()
@@ -153,10 +162,10 @@ def main():
         wd = a.out and os.path.join(a.out, re.sub(r"[^\w.-]", "_", os.path.splitext(os.path.basename(deck))[0]))
         if wd:
             os.makedirs(wd, exist_ok=True)
-            results.append(profile(deck, a.freq, wd, extra))
+            results.append(profile(deck, a.samples, wd, extra))
         else:
             with tempfile.TemporaryDirectory() as td:
-                results.append(profile(deck, a.freq, td, extra))
+                results.append(profile(deck, a.samples, td, extra))
         r = results[-1]
         print(f"{r['deck']}: " + ", ".join(f"{p} {100 * r['counts'][p] / max(r['attributed'], 1):.1f} %"
                                           for p in ORDER[:-1] if r["counts"][p])
