@@ -336,9 +336,11 @@ def main():
                 msg = (f"error {r['error']:.2e}, cpu {r['cpu']:.3f} s, {r['steps']} steps, {r['newton']} Newton"
                        if r["ok"] else f"FAILED: {r.get('why')}")
                 print(f"[{scene}] {code} {r['label']}: {msg}", flush=True)
-    with open(os.path.join(a.out, "runs.jsonl"), "w") as f:
+    tmp = os.path.join(a.out, "runs.jsonl.tmp")
+    with open(tmp, "w") as f:
         for r in records:
             f.write(json.dumps(r) + "\n")
+    os.replace(tmp, os.path.join(a.out, "runs.jsonl"))   # nothing half-written
     import tables
     tables.report(records, a.out)
 
