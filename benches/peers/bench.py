@@ -25,9 +25,7 @@ import csv
 import json
 import math
 import os
-import re
 import resource
-import shutil
 import subprocess
 import sys
 
