@@ -3,9 +3,9 @@
 
     python3 mbdyn_scenes.py SCENE --h H --n N --out RUN.csv [--method "ms, 0.6"] [--mbdyn BIN]
 
-SCENE is one of cantilever, spinup, slider_crank (the seed's pendulum is not modelled: its
-floor is a Kelvin-Voigt point-on-plane contact, which MBDyn's built-in elements do not
-offer). N is MBDyn's mesh (three-node `beam3` elements per leg, per beam or per rod), H its
+SCENE is one of cantilever, spinup, slider_crank (the seed's pendulum is not modelled yet:
+its floor, a Kelvin-Voigt point-on-plane contact, has no MBDyn element of its own;
+docs/performance.md, "What is not here"). N is MBDyn's mesh (three-node `beam3` elements per leg, per beam or per rod), H its
 fixed step. The run writes the MBDyn input file RUN.mbd beside RUN.csv, runs MBDyn on it,
 and writes RUN.csv, the scene's compared quantities at the scene's sampling instants (the
 columns of exudyn_scenes.py), and prints one line of JSON: code, scene, h, n, cpu (user +
