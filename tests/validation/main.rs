@@ -7,6 +7,7 @@ mod common;
 
 mod benchmarks;
 mod bend_shooting;
+mod converged;
 mod damping;
 mod high_order;
 mod pendulum;
