@@ -12,14 +12,22 @@ pub struct KeywordDoc {
     pub doc: &'static str,
 }
 
+use std::sync::LazyLock;
+
 const fn kw(name: &'static str, section: &'static str, doc: &'static str) -> KeywordDoc {
     KeywordDoc { name, section, doc }
 }
 
 /// Every keyword the parser accepts, with where it is used: the single source of truth
 /// for `grammar.md` (a test checks that each one is documented there). In debug builds the
-/// parser asserts that every keyword it matches is listed here.
-pub const KEYWORDS: &[KeywordDoc] = &[
+/// parser asserts that every keyword it matches is listed here. The rows below, then the
+/// rows of the registered element kinds (`crate::kinds`, each kind's `CARD`).
+pub static KEYWORDS: LazyLock<Vec<KeywordDoc>> =
+    LazyLock::new(|| ROWS.iter().copied().chain(super::build::rows()).collect());
+
+/// The keywords of the sections, of the shared element fields and of the kinds not yet in
+/// the registry.
+const ROWS: &[KeywordDoc] = &[
     // sections
     kw(
         "TITLE",
@@ -229,17 +237,6 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ELEMENTS",
         "BEAM: local axis 2 direction; UJOINT: axis on the second node",
     ),
-    kw(
-        "MASS",
-        "ELEMENTS",
-        "point mass with optional rotary inertia",
-    ),
-    kw("M", "ELEMENTS", "mass of a MASS element, kg (>= 0)"),
-    kw(
-        "INERTIA",
-        "ELEMENTS",
-        "rotary inertia of a MASS, kg·m², global frame at t = 0",
-    ),
     kw("HINGE", "ELEMENTS", "revolute joint"),
     kw("AXIS", "ELEMENTS", "axis of a HINGE or PRISMATIC joint"),
     kw("UJOINT", "ELEMENTS", "universal (Cardan) joint"),
@@ -333,36 +330,6 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
     kw(
-        "SPRING",
-        "ELEMENTS",
-        "two-node spring-damper along the line of its nodes (K, C, L0 or PRELOAD, CURVE)",
-    ),
-    kw(
-        "L0",
-        "ELEMENTS",
-        "SPRING: free length, m (>= 0; default: initial distance)",
-    ),
-    kw(
-        "PRELOAD",
-        "ELEMENTS",
-        "SPRING: tension at the initial distance, N (instead of L0)",
-    ),
-    kw(
-        "CURVE",
-        "ELEMENTS",
-        "SPRING: function number of a force-deflection curve F(deflection), N",
-    ),
-    kw(
-        "BUSHING",
-        "ELEMENTS",
-        "six-component linear bushing in a frame fixed to its first node",
-    ),
-    kw(
-        "AXES",
-        "ELEMENTS",
-        "BUSHING: axes e1 e2 of its frame, global at t = 0",
-    ),
-    kw(
         "SUPERELEMENT",
         "ELEMENTS",
         "a linear elastic body reduced from an FE model (Craig–Bampton in a floating frame)",
@@ -376,26 +343,6 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "INTERFACE",
         "ELEMENTS",
         "SUPERELEMENT: pairs <FE node> <node>; the first is the frame node",
-    ),
-    kw(
-        "RSPRING",
-        "ELEMENTS",
-        "rotational spring, damper and friction on a HINGE element",
-    ),
-    kw(
-        "THETA0",
-        "ELEMENTS",
-        "RSPRING: unloaded angle, rad (default 0)",
-    ),
-    kw(
-        "FRICTION",
-        "ELEMENTS",
-        "RSPRING: Coulomb friction torque, N·m (>= 0)",
-    ),
-    kw(
-        "WREG",
-        "ELEMENTS",
-        "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
     ),
     kw(
         "PID",

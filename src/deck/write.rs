@@ -7,13 +7,13 @@
 use crate::model::control::ControlLaw;
 use crate::model::{
     Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
-    Scheme, Section, SectionData, Selection, SpringLength,
+    Scheme, Section, SectionData, Selection,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
 use std::fmt::Write;
 
-fn v3(v: &Vector3<f64>) -> String {
+pub(super) fn v3(v: &Vector3<f64>) -> String {
     format!("{:?} {:?} {:?}", v.x, v.y, v.z)
 }
 
@@ -193,6 +193,11 @@ pub fn write_deck(model: &Model) -> String {
             if gen_elements.contains(&e.id) {
                 continue;
             }
+            // A registered kind writes its own card (`crate::kinds`).
+            if super::build::write_element(model, e, &mut s) {
+                s.push('\n');
+                continue;
+            }
             let division = model.divisions.get(&e.id);
             let nodes: Vec<String> = match division {
                 Some(d) => d.ends.iter().map(|n| n.0.to_string()).collect(),
@@ -204,7 +209,6 @@ pub fn write_deck(model: &Model) -> String {
                         .collect()
                 }
                 None => match &e.kind {
-                    ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
                     // Its interface nodes follow INTERFACE; its modal nodes are generated.
                     ElementKind::Superelement(_) => Vec::new(),
                     ElementKind::Control(c) => match (c.actuator, &c.law) {
@@ -247,22 +251,6 @@ pub fn write_deck(model: &Model) -> String {
                         let _ = write!(s, " ARC {}", v3(c));
                     }
                 }
-                ElementKind::Mass { mass, inertia } => {
-                    let _ = write!(s, " M {mass:?}");
-                    if *inertia != Matrix3::zeros() {
-                        let i = inertia;
-                        let _ = write!(
-                            s,
-                            " INERTIA {:?} {:?} {:?}",
-                            i[(0, 0)],
-                            i[(1, 1)],
-                            i[(2, 2)]
-                        );
-                        if i[(0, 1)] != 0.0 || i[(0, 2)] != 0.0 || i[(1, 2)] != 0.0 {
-                            let _ = write!(s, " {:?} {:?} {:?}", i[(0, 1)], i[(0, 2)], i[(1, 2)]);
-                        }
-                    }
-                }
                 ElementKind::Hinge { axis } | ElementKind::Prismatic { axis } => {
                     let _ = write!(s, " AXIS {}", v3(axis));
                     if let Some(d) = model.drives.get(&e.id) {
@@ -288,29 +276,6 @@ pub fn write_deck(model: &Model) -> String {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
                 }
                 ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
-                ElementKind::Spring(p) => {
-                    let _ = write!(s, " K {:?} C {:?}", p.stiffness, p.damping);
-                    match p.length {
-                        SpringLength::Initial => {}
-                        SpringLength::Free(l) => {
-                            let _ = write!(s, " L0 {l:?}");
-                        }
-                        SpringLength::Preload(f) => {
-                            let _ = write!(s, " PRELOAD {f:?}");
-                        }
-                    }
-                    if let Some(f) = p.curve {
-                        let _ = write!(s, " CURVE {}", f.0);
-                    }
-                }
-                ElementKind::Bushing(b) => {
-                    let six = |v: &[f64; 6]| v.map(|x| format!("{x:?}")).join(" ");
-                    let _ = write!(s, " K {} C {}", six(&b.stiffness), six(&b.damping));
-                    if b.axes != Matrix3::identity() {
-                        let col = |i: usize| v3(&b.axes.column(i).into_owned());
-                        let _ = write!(s, " AXES {} {}", col(0), col(1));
-                    }
-                }
                 ElementKind::Superelement(d) => {
                     let _ = write!(s, "FILES {} MODES {} INTERFACE", d.dir.display(), d.modes);
                     for (fe, node) in d.interface.iter().zip(&e.nodes) {
@@ -330,13 +295,6 @@ pub fn write_deck(model: &Model) -> String {
                     }
                     _ => {}
                 },
-                ElementKind::RSpring(r) => {
-                    let _ = write!(
-                        s,
-                        " K {:?} C {:?} THETA0 {:?} FRICTION {:?} WREG {:?}",
-                        r.stiffness, r.damping, r.angle0, r.friction, r.friction_speed
-                    );
-                }
                 ElementKind::Clearance(c) => {
                     let law = match c.law {
                         ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
@@ -372,6 +330,8 @@ pub fn write_deck(model: &Model) -> String {
                         c.impact_steps
                     );
                 }
+                // The registered kinds, written above.
+                _ => {}
             }
             s.push('\n');
         }

@@ -2,6 +2,7 @@
 
 use super::checks::{came_profiles, same_node, spline_points};
 use super::cursor::*;
+use super::kinds;
 use super::*;
 use crate::model::order::MAX_ORDER;
 
@@ -36,9 +37,9 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 17] = [
+        // The kinds not yet in the registry (`crate::kinds`), read below.
+        const TYPES: [&str; 13] = [
             "BEAM",
-            "MASS",
             "HINGE",
             "UJOINT",
             "SPHERICAL",
@@ -46,9 +47,6 @@ impl Builder<'_> {
             "PRISMATIC",
             "RIGID",
             "CAME",
-            "SPRING",
-            "BUSHING",
-            "RSPRING",
             "PID",
             "CONTROL",
             "PRESCRIBED",
@@ -56,7 +54,9 @@ impl Builder<'_> {
             "SUPERELEMENT",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
-        let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
+        let card = kinds::card(|k| t.is_kw(k));
+        let old = TYPES.iter().find(|k| t.is_kw(k)).copied();
+        let Some(ty) = card.map(|(_, ty)| ty).or(old) else {
             return Err(DeckError::new(
                 K::UnknownElementType {
                     found: t.text.to_string(),
@@ -67,8 +67,9 @@ impl Builder<'_> {
         if last.is_some() && ty != "BEAM" {
             return Err(c.unexpected(t, "BEAM (only beams can be generated with TO)"));
         }
-        let (nodes, kind): (Vec<(u32, Span)>, ElementKind) = match ty {
-            "BEAM" => {
+        let (nodes, kind): (Vec<(u32, Span)>, ElementKind) = match (card, ty) {
+            (Some((card, ty)), _) => (card.parse)(self, &mut c, id, ty)?,
+            (None, "BEAM") => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 let mut seen = Seen::default();
@@ -159,36 +160,7 @@ impl Builder<'_> {
                     id_span,
                 );
             }
-            "MASS" => {
-                let n = c.uint("node number")?;
-                c.expect_keyword(&["M"], "M <mass>")?;
-                let (m, ms, mt) = c.number("M (mass)")?;
-                if m < 0.0 {
-                    return Err(out_of_range("M (mass)", mt, ">= 0 kg", ms));
-                }
-                let mut inertia = Matrix3::zeros();
-                if c.keyword(&["INERTIA"]).is_some() {
-                    let mut comp = [0.0; 6];
-                    let names = ["Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"];
-                    for (k, name) in names.iter().enumerate() {
-                        if k == 3 && !c.next_is_number() {
-                            break;
-                        }
-                        let (v, s, t) = c.number(name)?;
-                        if k < 3 && v < 0.0 {
-                            return Err(out_of_range(name, t, ">= 0 kg·m²", s));
-                        }
-                        comp[k] = v;
-                    }
-                    inertia = Matrix3::new(
-                        comp[0], comp[3], comp[4], comp[3], comp[1], comp[5], comp[4], comp[5],
-                        comp[2],
-                    );
-                }
-                c.finish()?;
-                (vec![n], ElementKind::Mass { mass: m, inertia })
-            }
-            "HINGE" | "PRISMATIC" => {
+            (None, "HINGE" | "PRISMATIC") => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 c.expect_keyword(&["AXIS"], "AXIS <x> <y> <z>")?;
@@ -205,7 +177,7 @@ impl Builder<'_> {
                 };
                 (vec![n1, n2], kind)
             }
-            "UJOINT" => {
+            (None, "UJOINT") => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 c.expect_keyword(&["AXIS1"], "AXIS1 <x> <y> <z>")?;
@@ -230,7 +202,7 @@ impl Builder<'_> {
                     },
                 )
             }
-            "SPHERICAL" | "CLAMP" => {
+            (None, "SPHERICAL" | "CLAMP") => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 c.ctx = format!("element {id} ({ty})");
@@ -243,7 +215,7 @@ impl Builder<'_> {
                 };
                 (vec![n1, n2], kind)
             }
-            "RIGID" => {
+            (None, "RIGID") => {
                 c.ctx = format!("element {id} (RIGID)");
                 Self::refuse_drive(&c)?;
                 let mut ns = vec![c.uint("master node number")?, c.uint("second node number")?];
@@ -252,17 +224,14 @@ impl Builder<'_> {
                 }
                 (ns, ElementKind::Rigid)
             }
-            "SPRING" => self.spring_card(&mut c, id)?,
-            "BUSHING" => Self::bushing_card(&mut c)?,
-            "RSPRING" => self.rspring_card(&mut c, id)?,
-            "PID" => self.pid_card(&mut c, id)?,
-            "CONTROL" => self.control_card(&mut c, id)?,
-            "SUPERELEMENT" => Self::superelement_card(&mut c)?,
-            "PRESCRIBED" => {
+            (None, "PID") => self.pid_card(&mut c, id)?,
+            (None, "CONTROL") => self.control_card(&mut c, id)?,
+            (None, "SUPERELEMENT") => Self::superelement_card(&mut c)?,
+            (None, "PRESCRIBED") => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)
             }
-            "CLEARANCE" => {
+            (None, "CLEARANCE") => {
                 let bearing = c.uint("bearing node number")?;
                 let journal = c.uint("journal node number")?;
                 let data = Self::clearance(&mut c)?;
@@ -271,7 +240,7 @@ impl Builder<'_> {
                     ElementKind::Clearance(Box::new(data)),
                 )
             }
-            _ => {
+            (None, _) => {
                 let cam = c.uint("cam node number")?;
                 let fol = c.uint("follower node number")?;
                 let data = Self::came(&mut c, id)?;

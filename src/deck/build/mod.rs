@@ -9,11 +9,14 @@ mod cursor;
 mod drives;
 mod elements;
 mod functions;
+mod kinds;
 mod nodes;
 mod properties;
 mod section;
 mod springs;
 mod superelement;
+
+pub(super) use kinds::{rows, types, write_element};
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};

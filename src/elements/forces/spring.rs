@@ -30,11 +30,18 @@
 //! Newton reports a non-finite solution, the step is cut, and a run that cannot avoid the
 //! passage fails with this element's diagnosis ([`Element::diagnose`]).
 
-use super::{
+use crate::elements::registry::Kind;
+use crate::elements::{
     BuildError, Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, tx,
 };
 use crate::model::{self, ElementId, ElementKind, Function, Model, SpringData, SpringLength};
 use nalgebra::{Matrix3, Vector3};
+
+/// The element half of `SPRING` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["SPRING"],
+    build: from_model,
+};
 
 /// A SPRING element (see the module docs).
 #[derive(Debug, Clone)]

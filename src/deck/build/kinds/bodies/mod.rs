@@ -1,0 +1,3 @@
+//! Bodies: point masses, rigid bodies, superelements.
+
+pub(super) mod mass;
