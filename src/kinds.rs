@@ -20,6 +20,7 @@ macro_rules! element_kinds {
     ($then:ident) => {
         $then! {
             bodies::mass,
+            bodies::superelement,
             forces::spring,
             forces::bushing,
             forces::rspring,

@@ -330,21 +330,6 @@ const ROWS: &[KeywordDoc] = &[
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
     kw(
-        "SUPERELEMENT",
-        "ELEMENTS",
-        "a linear elastic body reduced from an FE model (Craig–Bampton in a floating frame)",
-    ),
-    kw(
-        "FILES",
-        "ELEMENTS",
-        "SUPERELEMENT: directory of K.mtx, M.mtx, nodes.csv, dofs.csv (relative to the deck's)",
-    ),
-    kw(
-        "INTERFACE",
-        "ELEMENTS",
-        "SUPERELEMENT: pairs <FE node> <node>; the first is the frame node",
-    ),
-    kw(
         "PID",
         "ELEMENTS",
         "PID controller: a torque on a HINGE element from its angle's error to a target a·f(t)",

@@ -209,8 +209,6 @@ pub fn write_deck(model: &Model) -> String {
                         .collect()
                 }
                 None => match &e.kind {
-                    // Its interface nodes follow INTERFACE; its modal nodes are generated.
-                    ElementKind::Superelement(_) => Vec::new(),
                     ElementKind::Control(c) => match (c.actuator, &c.law) {
                         (crate::model::control::Actuator::HingeTorque(h), ControlLaw::Pid(_)) => {
                             vec![h.0.to_string()]
@@ -276,12 +274,6 @@ pub fn write_deck(model: &Model) -> String {
                     let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
                 }
                 ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
-                ElementKind::Superelement(d) => {
-                    let _ = write!(s, "FILES {} MODES {} INTERFACE", d.dir.display(), d.modes);
-                    for (fe, node) in d.interface.iter().zip(&e.nodes) {
-                        let _ = write!(s, " {fe} {}", node.0);
-                    }
-                }
                 ElementKind::Control(c) => match &c.law {
                     ControlLaw::Pid(p) => {
                         let _ = write!(

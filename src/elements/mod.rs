@@ -28,9 +28,8 @@ pub mod prescribed;
 pub mod profile;
 pub mod registry;
 pub mod rigid_bar;
-pub mod superelement;
 
-pub use bodies::mass;
+pub use bodies::{mass, superelement};
 pub use forces::{bushing, rspring, spring};
 
 use crate::model::{ElementId, ElementKind, Model};
@@ -128,7 +127,6 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                 out.push(Box::new(control::Control::from_model(model, el, data)?))
             }
             k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
-            ElementKind::Superelement(d) => out.push(superelement::from_model(model, el, d)?),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }

@@ -38,7 +38,7 @@ impl Builder<'_> {
             last = Some(l);
         }
         // The kinds not yet in the registry (`crate::kinds`), read below.
-        const TYPES: [&str; 13] = [
+        const TYPES: [&str; 12] = [
             "BEAM",
             "HINGE",
             "UJOINT",
@@ -51,7 +51,6 @@ impl Builder<'_> {
             "CONTROL",
             "PRESCRIBED",
             "CLEARANCE",
-            "SUPERELEMENT",
         ];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let card = kinds::card(|k| t.is_kw(k));
@@ -226,7 +225,6 @@ impl Builder<'_> {
             }
             (None, "PID") => self.pid_card(&mut c, id)?,
             (None, "CONTROL") => self.control_card(&mut c, id)?,
-            (None, "SUPERELEMENT") => Self::superelement_card(&mut c)?,
             (None, "PRESCRIBED") => {
                 let (n, kind) = self.prescribed(&mut c)?;
                 (vec![n], kind)

@@ -14,7 +14,6 @@ mod nodes;
 mod properties;
 mod section;
 mod springs;
-mod superelement;
 
 pub(super) use kinds::{rows, types, write_element};
 

@@ -1,4 +1,5 @@
-//! Bodies: point masses (rigid bodies and superelements keep their former places until
-//! they move here; ARCHITECTURE.md).
+//! Bodies: point masses and superelements (rigid bodies keep their former place until they
+//! move here; ARCHITECTURE.md).
 
 pub mod mass;
+pub mod superelement;
