@@ -24,6 +24,10 @@ macro_rules! element_kinds {
             forces::spring,
             forces::bushing,
             forces::rspring,
+            joints::hinge,
+            joints::ujoint,
+            joints::spherical,
+            joints::rigid,
         }
     };
 }

@@ -237,18 +237,7 @@ const ROWS: &[KeywordDoc] = &[
         "ELEMENTS",
         "BEAM: local axis 2 direction; UJOINT: axis on the second node",
     ),
-    kw("HINGE", "ELEMENTS", "revolute joint"),
     kw("AXIS", "ELEMENTS", "axis of a HINGE or PRISMATIC joint"),
-    kw("UJOINT", "ELEMENTS", "universal (Cardan) joint"),
-    kw("AXIS1", "ELEMENTS", "UJOINT axis on the first node"),
-    kw("SPHERICAL", "ELEMENTS", "spherical joint"),
-    kw("CLAMP", "ELEMENTS", "two nodes welded together"),
-    kw("PRISMATIC", "ELEMENTS", "prismatic (sliding) joint"),
-    kw(
-        "DRIVE",
-        "ELEMENTS",
-        "HINGE or PRISMATIC: the angle or travel prescribed as a·f(t) (function number)",
-    ),
     kw(
         "AMPLITUDE",
         "ELEMENTS",

@@ -249,12 +249,6 @@ pub fn write_deck(model: &Model) -> String {
                         let _ = write!(s, " ARC {}", v3(c));
                     }
                 }
-                ElementKind::Hinge { axis } | ElementKind::Prismatic { axis } => {
-                    let _ = write!(s, " AXIS {}", v3(axis));
-                    if let Some(d) = model.drives.get(&e.id) {
-                        let _ = write!(s, " DRIVE {} AMPLITUDE {:?}", d.function.0, d.amplitude);
-                    }
-                }
                 ElementKind::Prescribed { motion, drive } => {
                     match motion {
                         crate::model::NodeMotion::Displacement(i) => {
@@ -270,10 +264,6 @@ pub fn write_deck(model: &Model) -> String {
                         drive.function.0, drive.amplitude
                     );
                 }
-                ElementKind::UJoint { axis1, axis2 } => {
-                    let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
-                }
-                ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
                 ElementKind::Control(c) => match &c.law {
                     ControlLaw::Pid(p) => {
                         let _ = write!(

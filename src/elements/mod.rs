@@ -126,7 +126,6 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
             ElementKind::Control(data) => {
                 out.push(Box::new(control::Control::from_model(model, el, data)?))
             }
-            k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }

@@ -24,6 +24,18 @@ fn decks() -> Vec<PathBuf> {
     v
 }
 
+/// Kinds no deck of `decks/` uses, in a deck of their own.
+const EXTRA: &str = "TITLE kinds no deck of decks/ uses
+NODES
+  1 0 0 0 FIX ALL
+  2 1 0 0
+ELEMENTS
+  1 MASS 2 M 1
+  2 CLAMP 1 2
+ANALYSIS DYNAMIC STEP 0.01 END 0.1
+END
+";
+
 #[test]
 fn every_registered_kind_has_both_halves() {
     let deck: Vec<&str> = registered_element_types().collect();
@@ -63,6 +75,7 @@ fn every_registered_kind_round_trips_through_the_writer() {
     let models: Vec<(PathBuf, mecano::model::Model)> = decks()
         .into_iter()
         .filter_map(|p| load_deck(&p).ok().map(|m| (p, m)))
+        .chain([(PathBuf::from("EXTRA"), parse_deck(EXTRA, "EXTRA").expect("parses"))])
         .collect();
     for ty in registered_element_types() {
         let using: Vec<_> = models

@@ -38,20 +38,7 @@ impl Builder<'_> {
             last = Some(l);
         }
         // The kinds not yet in the registry (`crate::kinds`), read below.
-        const TYPES: [&str; 12] = [
-            "BEAM",
-            "HINGE",
-            "UJOINT",
-            "SPHERICAL",
-            "CLAMP",
-            "PRISMATIC",
-            "RIGID",
-            "CAME",
-            "PID",
-            "CONTROL",
-            "PRESCRIBED",
-            "CLEARANCE",
-        ];
+        const TYPES: [&str; 6] = ["BEAM", "CAME", "PID", "CONTROL", "PRESCRIBED", "CLEARANCE"];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let card = kinds::card(|k| t.is_kw(k));
         let old = TYPES.iter().find(|k| t.is_kw(k)).copied();
@@ -158,70 +145,6 @@ impl Builder<'_> {
                     span,
                     id_span,
                 );
-            }
-            (None, "HINGE" | "PRISMATIC") => {
-                let n1 = c.uint("first node number")?;
-                let n2 = c.uint("second node number")?;
-                c.expect_keyword(&["AXIS"], "AXIS <x> <y> <z>")?;
-                let (axis, _, _) = c.axis(&format!("{ty} AXIS"))?;
-                if let Some(d) = self.drive_option(&mut c)? {
-                    c.finish()?;
-                    self.drives.insert(ElementId(id), d);
-                }
-                c.finish()?;
-                let kind = if ty == "HINGE" {
-                    ElementKind::Hinge { axis }
-                } else {
-                    ElementKind::Prismatic { axis }
-                };
-                (vec![n1, n2], kind)
-            }
-            (None, "UJOINT") => {
-                let n1 = c.uint("first node number")?;
-                let n2 = c.uint("second node number")?;
-                c.expect_keyword(&["AXIS1"], "AXIS1 <x> <y> <z>")?;
-                let (a1, r1, s1) = c.axis("UJOINT AXIS1")?;
-                c.expect_keyword(&["AXIS2"], "AXIS2 <x> <y> <z>")?;
-                let (a2, r2, s2) = c.axis("UJOINT AXIS2")?;
-                c.ctx = format!("element {id} (UJOINT)");
-                Self::refuse_drive(&c)?;
-                c.finish()?;
-                let dot = r1.dot(&r2).abs() / (r1.norm() * r2.norm());
-                if dot.is_nan() || dot > 1e-6 {
-                    return Err(DeckError::new(
-                        K::UJointNotPerpendicular { element: id, dot },
-                        Span::new(s1.start, s2.end),
-                    ));
-                }
-                (
-                    vec![n1, n2],
-                    ElementKind::UJoint {
-                        axis1: a1,
-                        axis2: a2,
-                    },
-                )
-            }
-            (None, "SPHERICAL" | "CLAMP") => {
-                let n1 = c.uint("first node number")?;
-                let n2 = c.uint("second node number")?;
-                c.ctx = format!("element {id} ({ty})");
-                Self::refuse_drive(&c)?;
-                c.finish()?;
-                let kind = if ty == "CLAMP" {
-                    ElementKind::Clamp
-                } else {
-                    ElementKind::Spherical
-                };
-                (vec![n1, n2], kind)
-            }
-            (None, "RIGID") => {
-                c.ctx = format!("element {id} (RIGID)");
-                Self::refuse_drive(&c)?;
-                let mut ns = vec![c.uint("master node number")?, c.uint("second node number")?];
-                while c.peek().is_some() {
-                    ns.push(c.uint("node number")?);
-                }
-                (ns, ElementKind::Rigid)
             }
             (None, "PID") => self.pid_card(&mut c, id)?,
             (None, "CONTROL") => self.control_card(&mut c, id)?,

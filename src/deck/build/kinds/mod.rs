@@ -11,6 +11,7 @@ use std::fmt::Write;
 
 mod bodies;
 mod forces;
+mod joints;
 
 /// What a card gives to the element loop: its nodes (numbers, spans) and kind.
 pub(super) type Parsed = (Vec<(u32, Span)>, ElementKind);
