@@ -21,6 +21,8 @@ macro_rules! element_kinds {
         $then! {
             bodies::mass,
             bodies::superelement,
+            contact::came,
+            contact::clearance,
             forces::spring,
             forces::bushing,
             forces::rspring,

@@ -253,43 +253,10 @@ const ROWS: &[KeywordDoc] = &[
         "ELEMENTS",
         "PRESCRIBED: the node's rotation about a fixed global axis",
     ),
-    kw("CAME", "ELEMENTS", "cam-follower contact element"),
-    kw("CAM", "ELEMENTS", "CAME: the cam's profile (first node)"),
-    kw(
-        "FOLLOWER",
-        "ELEMENTS",
-        "CAME: the follower's profile (second node)",
-    ),
-    kw("POINT", "ELEMENTS", "CAME profile: a point"),
-    kw(
-        "CIRCLE",
-        "ELEMENTS",
-        "CAME profile: a circle of given radius",
-    ),
     kw(
         "SPLINE",
         "ELEMENTS",
         "CAME profile: a cubic spline through points (FUNCTIONS: the C² time function)",
-    ),
-    kw(
-        "CLOSED",
-        "ELEMENTS",
-        "CAME SPLINE: a closed (periodic) curve",
-    ),
-    kw(
-        "ANGLE",
-        "ELEMENTS",
-        "CAME LINE: in-plane direction angle, degrees",
-    ),
-    kw(
-        "OFFSET",
-        "ELEMENTS",
-        "CAME profile: origin offset in the node frame, m",
-    ),
-    kw(
-        "PLANE",
-        "ELEMENTS",
-        "CAME profile: plane vectors e1 e2 in the node frame",
     ),
     kw(
         "C",
@@ -306,13 +273,6 @@ const ROWS: &[KeywordDoc] = &[
         "ELEMENTS",
         "CAME: friction regularisation speed, m/s (> 0, default 1e-3)",
     ),
-    kw(
-        "CLIP",
-        "ELEMENTS",
-        "CAME: clip the adhesive part of the contact force (ON/OFF)",
-    ),
-    kw("ON", "ELEMENTS", "CLIP ON"),
-    kw("OFF", "ELEMENTS", "CLIP OFF"),
     kw(
         "IMPACT_STEPS",
         "ELEMENTS",
@@ -342,31 +302,9 @@ const ROWS: &[KeywordDoc] = &[
         "CONTROL: the input is a torque about the axis of the HINGE element that follows, N·m",
     ),
     kw(
-        "CLEARANCE",
-        "ELEMENTS",
-        "revolute joint with radial clearance (element type; and its clearance, m)",
-    ),
-    kw("RADIUS", "ELEMENTS", "CLEARANCE: bearing radius, m"),
-    kw(
         "LAW",
         "ELEMENTS",
         "CLEARANCE: the normal force law (KV or LN); CONTROL: the input's value, an expression of t and sensors",
-    ),
-    kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
-    kw(
-        "LN",
-        "ELEMENTS",
-        "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
-    ),
-    kw(
-        "EXPONENT",
-        "ELEMENTS",
-        "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
-    ),
-    kw(
-        "VMIN",
-        "ELEMENTS",
-        "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
     ),
     // functions
     kw(

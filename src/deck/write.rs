@@ -6,10 +6,10 @@
 
 use crate::model::control::ControlLaw;
 use crate::model::{
-    Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
-    Scheme, Section, SectionData, Selection,
+    Analysis, ElementId, ElementKind, Function, Model, NodeId, Scheme, Section, SectionData,
+    Selection,
 };
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use std::collections::HashSet;
 use std::fmt::Write;
 
@@ -29,34 +29,6 @@ fn dofs(fixed: &[bool; 6]) -> String {
         .map(|(n, _)| *n)
         .collect();
     names.join(" ")
-}
-
-fn profile(p: &PlacedProfile) -> String {
-    let mut s = match &p.profile {
-        Profile::Line => "LINE".to_string(),
-        Profile::Point => "POINT".to_string(),
-        Profile::Circle { radius } => format!("CIRCLE {radius:?}"),
-        Profile::Spline { points, closed } => {
-            let mut s = String::from("SPLINE");
-            if *closed {
-                s.push_str(" CLOSED");
-            }
-            let _ = write!(s, " {}", points.len());
-            for [x, y] in points {
-                let _ = write!(s, " {x:?} {y:?}");
-            }
-            s
-        }
-    };
-    if p.offset != Vector3::zeros() {
-        let _ = write!(s, " OFFSET {}", v3(&p.offset));
-    }
-    if p.frame != Matrix3::identity() {
-        let e1: Vector3<f64> = p.frame.column(0).into();
-        let e2: Vector3<f64> = p.frame.column(1).into();
-        let _ = write!(s, " PLANE {} {}", v3(&e1), v3(&e2));
-    }
-    s
 }
 
 fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
@@ -277,41 +249,6 @@ pub fn write_deck(model: &Model) -> String {
                     }
                     _ => {}
                 },
-                ElementKind::Clearance(c) => {
-                    let law = match c.law {
-                        ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
-                        ContactLaw::LankaraniNikravesh {
-                            k,
-                            exponent,
-                            restitution,
-                        } => format!("LN {k:?} {restitution:?} EXPONENT {exponent:?}"),
-                    };
-                    let _ = write!(
-                        s,
-                        " AXIS {} RADIUS {:?} CLEARANCE {:?} LAW {law} MU {:?} VREG {:?} VMIN {:?} IMPACT_STEPS {}",
-                        v3(&c.axis),
-                        c.radius,
-                        c.clearance,
-                        c.friction,
-                        c.friction_speed,
-                        c.min_approach,
-                        c.impact_steps
-                    );
-                }
-                ElementKind::Came(c) => {
-                    let _ = write!(
-                        s,
-                        " CAM {} FOLLOWER {} K {:?} C {:?} MU {:?} VREG {:?} CLIP {} IMPACT_STEPS {}",
-                        profile(&c.cam),
-                        profile(&c.follower),
-                        c.stiffness,
-                        c.damping,
-                        c.friction,
-                        c.friction_speed,
-                        if c.clip_tension { "ON" } else { "OFF" },
-                        c.impact_steps
-                    );
-                }
                 // The registered kinds, written above.
                 _ => {}
             }

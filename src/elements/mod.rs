@@ -18,18 +18,17 @@
 pub mod beam;
 pub mod beam_p;
 pub mod bodies;
-pub mod came;
-pub mod clearance;
+pub mod contact;
 pub mod control;
 pub mod drive;
 pub mod forces;
 pub mod joints;
 pub mod prescribed;
-pub mod profile;
 pub mod registry;
 pub mod rigid_bar;
 
 pub use bodies::{mass, superelement};
+pub use contact::{came, clearance, profile};
 pub use forces::{bushing, rspring, spring};
 
 use crate::model::{ElementId, ElementKind, Model};
@@ -91,18 +90,6 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     out.push(beam_p::from_model(model, el, nodes));
                 }
             }
-            ElementKind::Came(data) => {
-                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
-                match came::Came::new(el.id, nodes, data) {
-                    Ok(c) => out.push(Box::new(c)),
-                    Err(message) => {
-                        return Err(BuildError::Invalid {
-                            element: el.id,
-                            message,
-                        });
-                    }
-                }
-            }
             ElementKind::Prescribed { motion, drive } => {
                 let i = idx(&el.nodes[0]);
                 out.push(Box::new(prescribed::Prescribed::new(
@@ -112,16 +99,6 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     *motion,
                     drive::TimeLaw::from_model(model, drive),
                 )));
-            }
-            ElementKind::Clearance(data) => {
-                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
-                let c = clearance::Clearance::new(el.id, nodes, data).map_err(|message| {
-                    BuildError::Invalid {
-                        element: el.id,
-                        message,
-                    }
-                })?;
-                out.push(Box::new(c));
             }
             ElementKind::Control(data) => {
                 out.push(Box::new(control::Control::from_model(model, el, data)?))

@@ -75,7 +75,10 @@ fn every_registered_kind_round_trips_through_the_writer() {
     let models: Vec<(PathBuf, mecano::model::Model)> = decks()
         .into_iter()
         .filter_map(|p| load_deck(&p).ok().map(|m| (p, m)))
-        .chain([(PathBuf::from("EXTRA"), parse_deck(EXTRA, "EXTRA").expect("parses"))])
+        .chain([(
+            PathBuf::from("EXTRA"),
+            parse_deck(EXTRA, "EXTRA").expect("parses"),
+        )])
         .collect();
     for ty in registered_element_types() {
         let using: Vec<_> = models

@@ -3,7 +3,6 @@
 
 mod analysis;
 mod checks;
-mod clearance;
 mod control;
 mod cursor;
 mod drives;

@@ -10,6 +10,7 @@ use crate::model::{Element, ElementKind, Model, Span};
 use std::fmt::Write;
 
 mod bodies;
+mod contact;
 mod forces;
 mod joints;
 
