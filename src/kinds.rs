@@ -26,10 +26,12 @@ macro_rules! element_kinds {
             forces::spring,
             forces::bushing,
             forces::rspring,
+            forces::control,
             joints::hinge,
             joints::ujoint,
             joints::spherical,
             joints::rigid,
+            joints::prescribed,
         }
     };
 }

@@ -244,16 +244,6 @@ const ROWS: &[KeywordDoc] = &[
         "DRIVE or PRESCRIBED: the factor a of a·f(t), rad or m (default 1)",
     ),
     kw(
-        "PRESCRIBED",
-        "ELEMENTS",
-        "a node's displacement component (X, Y, Z) or rotation about a fixed axis prescribed as a·f(t)",
-    ),
-    kw(
-        "ROTATION",
-        "ELEMENTS",
-        "PRESCRIBED: the node's rotation about a fixed global axis",
-    ),
-    kw(
         "SPLINE",
         "ELEMENTS",
         "CAME profile: a cubic spline through points (FUNCTIONS: the C² time function)",
@@ -277,29 +267,6 @@ const ROWS: &[KeywordDoc] = &[
         "IMPACT_STEPS",
         "ELEMENTS",
         "CAME: minimum steps per impact (>= 1, default 10)",
-    ),
-    kw(
-        "PID",
-        "ELEMENTS",
-        "PID controller: a torque on a HINGE element from its angle's error to a target a·f(t)",
-    ),
-    kw("KP", "ELEMENTS", "PID: proportional gain, N·m/rad (>= 0)"),
-    kw("KI", "ELEMENTS", "PID: integral gain, N·m/(rad·s) (>= 0)"),
-    kw("KD", "ELEMENTS", "PID: derivative gain, N·m·s/rad (>= 0)"),
-    kw(
-        "TARGET",
-        "ELEMENTS",
-        "PID: function number of the target angle f(t) (exact derivatives; AMPLITUDE a scales it)",
-    ),
-    kw(
-        "CONTROL",
-        "ELEMENTS",
-        "controlled input: a torque on a HINGE (TORQUE) or a force on a node (FORCE) whose LAW is an expression of t and sensors",
-    ),
-    kw(
-        "TORQUE",
-        "ELEMENTS",
-        "CONTROL: the input is a torque about the axis of the HINGE element that follows, N·m",
     ),
     kw(
         "LAW",

@@ -4,7 +4,6 @@
 //! generated nodes and elements are written one per line; every analysis setting is
 //! written explicitly.
 
-use crate::model::control::ControlLaw;
 use crate::model::{
     Analysis, ElementId, ElementKind, Function, Model, NodeId, Scheme, Section, SectionData,
     Selection,
@@ -180,77 +179,34 @@ pub fn write_deck(model: &Model) -> String {
                         .map(|n| n.0.to_string())
                         .collect()
                 }
-                None => match &e.kind {
-                    ElementKind::Control(c) => match (c.actuator, &c.law) {
-                        (crate::model::control::Actuator::HingeTorque(h), ControlLaw::Pid(_)) => {
-                            vec![h.0.to_string()]
-                        }
-                        (crate::model::control::Actuator::HingeTorque(h), _) => {
-                            vec![format!("TORQUE {}", h.0)]
-                        }
-                        (crate::model::control::Actuator::NodeForce(n, a), _) => {
-                            vec![format!("FORCE {} {}", n.0, ["X", "Y", "Z"][a.min(2)])]
-                        }
-                    },
-                    _ => e.nodes.iter().map(|n| n.0.to_string()).collect(),
-                },
+                None => e.nodes.iter().map(|n| n.0.to_string()).collect(),
             };
+            // A BEAM (the one kind not in the registry yet).
             let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
-            match &e.kind {
-                ElementKind::Beam {
-                    material,
-                    section,
-                    axis2,
-                    order,
-                    arc,
-                } => {
-                    if let Some(m) = material {
-                        let _ = write!(s, " MAT {}", m.0);
-                    }
-                    let _ = write!(s, " SEC {}", section.0);
-                    if let Some(a) = axis2 {
-                        let _ = write!(s, " AXIS2 {}", v3(a));
-                    }
-                    if let Some(d) = division {
-                        let _ = write!(s, " DIVIDE {}", d.count());
-                    }
-                    if *order > 1 {
-                        let _ = write!(s, " ORDER {order}");
-                    }
-                    if let Some(c) = arc {
-                        let _ = write!(s, " ARC {}", v3(c));
-                    }
+            if let ElementKind::Beam {
+                material,
+                section,
+                axis2,
+                order,
+                arc,
+            } = &e.kind
+            {
+                if let Some(m) = material {
+                    let _ = write!(s, " MAT {}", m.0);
                 }
-                ElementKind::Prescribed { motion, drive } => {
-                    match motion {
-                        crate::model::NodeMotion::Displacement(i) => {
-                            let _ = write!(s, " {}", ["X", "Y", "Z"][*i]);
-                        }
-                        crate::model::NodeMotion::Rotation(a) => {
-                            let _ = write!(s, " ROTATION AXIS {}", v3(a));
-                        }
-                    }
-                    let _ = write!(
-                        s,
-                        " FUNCTION {} AMPLITUDE {:?}",
-                        drive.function.0, drive.amplitude
-                    );
+                let _ = write!(s, " SEC {}", section.0);
+                if let Some(a) = axis2 {
+                    let _ = write!(s, " AXIS2 {}", v3(a));
                 }
-                ElementKind::Control(c) => match &c.law {
-                    ControlLaw::Pid(p) => {
-                        let _ = write!(
-                            s,
-                            " KP {:?} KI {:?} KD {:?} TARGET {} AMPLITUDE {:?}",
-                            p.kp, p.ki, p.kd, p.target.0, p.amplitude
-                        );
-                    }
-                    ControlLaw::Expr(e) => {
-                        let _ = write!(s, " LAW {}", e.text);
-                    }
-                    _ => {}
-                },
-                // The registered kinds, written above.
-                _ => {}
+                if let Some(d) = division {
+                    let _ = write!(s, " DIVIDE {}", d.count());
+                }
+                if *order > 1 {
+                    let _ = write!(s, " ORDER {order}");
+                }
+                if let Some(c) = arc {
+                    let _ = write!(s, " ARC {}", v3(c));
+                }
             }
             s.push('\n');
         }

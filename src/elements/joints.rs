@@ -369,5 +369,6 @@ mod constraints;
 mod drive;
 mod element;
 mod outputs;
+pub mod prescribed;
 #[cfg(test)]
 mod tests;

@@ -19,17 +19,16 @@ pub mod beam;
 pub mod beam_p;
 pub mod bodies;
 pub mod contact;
-pub mod control;
 pub mod drive;
 pub mod forces;
 pub mod joints;
-pub mod prescribed;
 pub mod registry;
 pub mod rigid_bar;
 
 pub use bodies::{mass, superelement};
 pub use contact::{came, clearance, profile};
-pub use forces::{bushing, rspring, spring};
+pub use forces::{bushing, control, rspring, spring};
+pub use joints::prescribed;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -89,19 +88,6 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                 } else {
                     out.push(beam_p::from_model(model, el, nodes));
                 }
-            }
-            ElementKind::Prescribed { motion, drive } => {
-                let i = idx(&el.nodes[0]);
-                out.push(Box::new(prescribed::Prescribed::new(
-                    el.id,
-                    i,
-                    model.nodes[i].position,
-                    *motion,
-                    drive::TimeLaw::from_model(model, drive),
-                )));
-            }
-            ElementKind::Control(data) => {
-                out.push(Box::new(control::Control::from_model(model, el, data)?))
             }
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }

@@ -38,7 +38,7 @@ impl Builder<'_> {
             last = Some(l);
         }
         // The kinds not yet in the registry (`crate::kinds`), read below.
-        const TYPES: [&str; 4] = ["BEAM", "PID", "CONTROL", "PRESCRIBED"];
+        const TYPES: [&str; 1] = ["BEAM"];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
         let card = kinds::card(|k| t.is_kw(k));
         let old = TYPES.iter().find(|k| t.is_kw(k)).copied();
@@ -55,7 +55,7 @@ impl Builder<'_> {
         }
         let (nodes, kind): (Vec<(u32, Span)>, ElementKind) = match (card, ty) {
             (Some((card, ty)), _) => (card.parse)(self, &mut c, id, ty)?,
-            (None, "BEAM") => {
+            (None, _) => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 let mut seen = Seen::default();
@@ -145,13 +145,6 @@ impl Builder<'_> {
                     span,
                     id_span,
                 );
-            }
-            (None, "PID") => self.pid_card(&mut c, id)?,
-            (None, "CONTROL") => self.control_card(&mut c, id)?,
-            // PRESCRIBED, the last of TYPES.
-            (None, _) => {
-                let (n, kind) = self.prescribed(&mut c)?;
-                (vec![n], kind)
             }
         };
         if ty != "BEAM" {

@@ -2,5 +2,6 @@
 //! (`spring::from_model` builds all three).
 
 pub mod bushing;
+pub mod control;
 pub mod rspring;
 pub mod spring;

@@ -2,5 +2,6 @@
 //! "Springs, bushings and rotational springs").
 
 pub(super) mod bushing;
+pub(super) mod control;
 pub(super) mod rspring;
 pub(super) mod spring;
