@@ -8,13 +8,10 @@ use crate::model::{
     Analysis, ElementId, ElementKind, Function, Model, NodeId, Scheme, Section, SectionData,
     Selection,
 };
-use nalgebra::Vector3;
 use std::collections::HashSet;
 use std::fmt::Write;
 
-pub(super) fn v3(v: &Vector3<f64>) -> String {
-    format!("{:?} {:?} {:?}", v.x, v.y, v.z)
-}
+use super::build::v3;
 
 fn dofs(fixed: &[bool; 6]) -> String {
     if fixed.iter().all(|f| *f) {

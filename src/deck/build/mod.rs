@@ -14,7 +14,7 @@ mod properties;
 mod section;
 mod springs;
 
-pub(super) use kinds::{rows, types, write_element};
+pub(super) use kinds::{rows, types, v3, write_element};
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};

@@ -35,10 +35,10 @@ use nalgebra::{Matrix3, Vector3};
 
 type D12 = Dual<12>;
 
-/// The element half of `BUSHING` (`crate::kinds`): built by [`super::spring::from_model`].
+/// The element half of `BUSHING` (`crate::kinds`): built by [`super::from_model`].
 pub const KIND: Kind = Kind {
     types: &["BUSHING"],
-    build: super::spring::from_model,
+    build: super::from_model,
 };
 
 /// A BUSHING element (see the module docs).

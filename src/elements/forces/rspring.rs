@@ -39,10 +39,10 @@ use nalgebra::{Matrix3, Vector3, Vector6};
 
 type D6 = Dual<6>;
 
-/// The element half of `RSPRING` (`crate::kinds`): built by [`super::spring::from_model`].
+/// The element half of `RSPRING` (`crate::kinds`): built by [`super::from_model`].
 pub const KIND: Kind = Kind {
     types: &["RSPRING"],
-    build: super::spring::from_model,
+    build: super::from_model,
 };
 
 /// An RSPRING element (see the module docs).

@@ -74,6 +74,12 @@ pub(super) fn node_list(e: &Element) -> String {
     n.join(" ")
 }
 
+/// A vector as the writer prints it: `x y z`, each the shortest text that reads back
+/// exactly.
+pub(in crate::deck) fn v3(v: &nalgebra::Vector3<f64>) -> String {
+    format!("{:?} {:?} {:?}", v.x, v.y, v.z)
+}
+
 /// A documentation row of section `ELEMENTS`.
 pub(super) const fn row(name: &'static str, doc: &'static str) -> KeywordDoc {
     KeywordDoc {

@@ -2,11 +2,11 @@
 //! [CLIP ON|OFF] [IMPACT_STEPS n]`: cam–follower contact between two profiles
 //! (grammar.md, "Elements").
 
+use super::super::v3;
 use super::super::{Card, node_list, row};
 use crate::deck::build::checks::{came_profiles, spline_points};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
-use crate::deck::write::v3;
 use std::fmt::Write;
 
 /// The deck half of `CAME`.

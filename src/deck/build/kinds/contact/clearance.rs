@@ -1,10 +1,10 @@
 //! `CLEARANCE <bearing> <journal> AXIS … RADIUS … CLEARANCE … LAW …`: a revolute joint
 //! with radial clearance (grammar.md, "Elements").
 
+use super::super::v3;
 use super::super::{Card, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
-use crate::deck::write::v3;
 use crate::model::{ClearanceData, ContactLaw};
 use std::fmt::Write;
 

@@ -103,7 +103,7 @@ fn write(_: &Model, e: &Element, s: &mut String) {
     let six = |v: &[f64; 6]| v.map(|x| format!("{x:?}")).join(" ");
     let _ = write!(s, " K {} C {}", six(&b.stiffness), six(&b.damping));
     if b.axes != Matrix3::identity() {
-        let col = |i: usize| crate::deck::write::v3(&b.axes.column(i).into_owned());
+        let col = |i: usize| super::super::v3(&b.axes.column(i).into_owned());
         let _ = write!(s, " AXES {} {}", col(0), col(1));
     }
 }

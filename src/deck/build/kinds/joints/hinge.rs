@@ -1,10 +1,10 @@
 //! `HINGE` and `PRISMATIC <n1> <n2> AXIS <x> <y> <z> [DRIVE <f> [AMPLITUDE <a>]]`: a revolute
 //! or sliding joint, its angle or travel optionally driven as a·f(t) (`build/drives.rs`).
 
+use super::super::v3;
 use super::super::{Card, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
-use crate::deck::write::v3;
 use std::fmt::Write;
 
 /// The deck half of `HINGE` and `PRISMATIC`.

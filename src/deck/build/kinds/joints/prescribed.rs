@@ -2,8 +2,8 @@
 //! node's displacement or rotation driven in time. Its reader stays in `build/drives.rs`
 //! beside the checks HINGE's `DRIVE` shares (a fixed or already driven freedom refused).
 
+use super::super::v3;
 use super::super::{Card, node_list, row};
-use crate::deck::write::v3;
 use crate::model::{ElementKind, NodeMotion};
 use std::fmt::Write;
 

@@ -1,10 +1,10 @@
 //! `UJOINT <n1> <n2> AXIS1 <x> <y> <z> AXIS2 <x> <y> <z>`: a universal (Cardan) joint, its
 //! axes perpendicular at t = 0.
 
+use super::super::v3;
 use super::super::{Card, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
-use crate::deck::write::v3;
 use std::fmt::Write;
 
 /// The deck half of `UJOINT`.
