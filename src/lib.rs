@@ -17,6 +17,7 @@ pub mod failpoint;
 pub mod figure;
 pub mod interrupt;
 pub mod interval;
+mod kinds;
 pub mod lagrange;
 pub mod model;
 pub mod modes;

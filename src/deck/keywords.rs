@@ -12,14 +12,22 @@ pub struct KeywordDoc {
     pub doc: &'static str,
 }
 
+use std::sync::LazyLock;
+
 const fn kw(name: &'static str, section: &'static str, doc: &'static str) -> KeywordDoc {
     KeywordDoc { name, section, doc }
 }
 
 /// Every keyword the parser accepts, with where it is used: the single source of truth
 /// for `grammar.md` (a test checks that each one is documented there). In debug builds the
-/// parser asserts that every keyword it matches is listed here.
-pub const KEYWORDS: &[KeywordDoc] = &[
+/// parser asserts that every keyword it matches is listed here. The rows below, then the
+/// rows of the registered element kinds (`crate::kinds`, each kind's `CARD`).
+pub static KEYWORDS: LazyLock<Vec<KeywordDoc>> =
+    LazyLock::new(|| ROWS.iter().copied().chain(super::build::rows()).collect());
+
+/// The keywords of the sections, of the shared element fields and of the kinds not yet in
+/// the registry.
+const ROWS: &[KeywordDoc] = &[
     // sections
     kw(
         "TITLE",
@@ -229,81 +237,16 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "ELEMENTS",
         "BEAM: local axis 2 direction; UJOINT: axis on the second node",
     ),
-    kw(
-        "MASS",
-        "ELEMENTS",
-        "point mass with optional rotary inertia",
-    ),
-    kw("M", "ELEMENTS", "mass of a MASS element, kg (>= 0)"),
-    kw(
-        "INERTIA",
-        "ELEMENTS",
-        "rotary inertia of a MASS, kg·m², global frame at t = 0",
-    ),
-    kw("HINGE", "ELEMENTS", "revolute joint"),
     kw("AXIS", "ELEMENTS", "axis of a HINGE or PRISMATIC joint"),
-    kw("UJOINT", "ELEMENTS", "universal (Cardan) joint"),
-    kw("AXIS1", "ELEMENTS", "UJOINT axis on the first node"),
-    kw("SPHERICAL", "ELEMENTS", "spherical joint"),
-    kw("CLAMP", "ELEMENTS", "two nodes welded together"),
-    kw("PRISMATIC", "ELEMENTS", "prismatic (sliding) joint"),
-    kw(
-        "DRIVE",
-        "ELEMENTS",
-        "HINGE or PRISMATIC: the angle or travel prescribed as a·f(t) (function number)",
-    ),
     kw(
         "AMPLITUDE",
         "ELEMENTS",
         "DRIVE or PRESCRIBED: the factor a of a·f(t), rad or m (default 1)",
     ),
     kw(
-        "PRESCRIBED",
-        "ELEMENTS",
-        "a node's displacement component (X, Y, Z) or rotation about a fixed axis prescribed as a·f(t)",
-    ),
-    kw(
-        "ROTATION",
-        "ELEMENTS",
-        "PRESCRIBED: the node's rotation about a fixed global axis",
-    ),
-    kw("CAME", "ELEMENTS", "cam-follower contact element"),
-    kw("CAM", "ELEMENTS", "CAME: the cam's profile (first node)"),
-    kw(
-        "FOLLOWER",
-        "ELEMENTS",
-        "CAME: the follower's profile (second node)",
-    ),
-    kw("POINT", "ELEMENTS", "CAME profile: a point"),
-    kw(
-        "CIRCLE",
-        "ELEMENTS",
-        "CAME profile: a circle of given radius",
-    ),
-    kw(
         "SPLINE",
         "ELEMENTS",
         "CAME profile: a cubic spline through points (FUNCTIONS: the C² time function)",
-    ),
-    kw(
-        "CLOSED",
-        "ELEMENTS",
-        "CAME SPLINE: a closed (periodic) curve",
-    ),
-    kw(
-        "ANGLE",
-        "ELEMENTS",
-        "CAME LINE: in-plane direction angle, degrees",
-    ),
-    kw(
-        "OFFSET",
-        "ELEMENTS",
-        "CAME profile: origin offset in the node frame, m",
-    ),
-    kw(
-        "PLANE",
-        "ELEMENTS",
-        "CAME profile: plane vectors e1 e2 in the node frame",
     ),
     kw(
         "C",
@@ -321,131 +264,14 @@ pub const KEYWORDS: &[KeywordDoc] = &[
         "CAME: friction regularisation speed, m/s (> 0, default 1e-3)",
     ),
     kw(
-        "CLIP",
-        "ELEMENTS",
-        "CAME: clip the adhesive part of the contact force (ON/OFF)",
-    ),
-    kw("ON", "ELEMENTS", "CLIP ON"),
-    kw("OFF", "ELEMENTS", "CLIP OFF"),
-    kw(
         "IMPACT_STEPS",
         "ELEMENTS",
         "CAME: minimum steps per impact (>= 1, default 10)",
     ),
     kw(
-        "SPRING",
-        "ELEMENTS",
-        "two-node spring-damper along the line of its nodes (K, C, L0 or PRELOAD, CURVE)",
-    ),
-    kw(
-        "L0",
-        "ELEMENTS",
-        "SPRING: free length, m (>= 0; default: initial distance)",
-    ),
-    kw(
-        "PRELOAD",
-        "ELEMENTS",
-        "SPRING: tension at the initial distance, N (instead of L0)",
-    ),
-    kw(
-        "CURVE",
-        "ELEMENTS",
-        "SPRING: function number of a force-deflection curve F(deflection), N",
-    ),
-    kw(
-        "BUSHING",
-        "ELEMENTS",
-        "six-component linear bushing in a frame fixed to its first node",
-    ),
-    kw(
-        "AXES",
-        "ELEMENTS",
-        "BUSHING: axes e1 e2 of its frame, global at t = 0",
-    ),
-    kw(
-        "SUPERELEMENT",
-        "ELEMENTS",
-        "a linear elastic body reduced from an FE model (Craig–Bampton in a floating frame)",
-    ),
-    kw(
-        "FILES",
-        "ELEMENTS",
-        "SUPERELEMENT: directory of K.mtx, M.mtx, nodes.csv, dofs.csv (relative to the deck's)",
-    ),
-    kw(
-        "INTERFACE",
-        "ELEMENTS",
-        "SUPERELEMENT: pairs <FE node> <node>; the first is the frame node",
-    ),
-    kw(
-        "RSPRING",
-        "ELEMENTS",
-        "rotational spring, damper and friction on a HINGE element",
-    ),
-    kw(
-        "THETA0",
-        "ELEMENTS",
-        "RSPRING: unloaded angle, rad (default 0)",
-    ),
-    kw(
-        "FRICTION",
-        "ELEMENTS",
-        "RSPRING: Coulomb friction torque, N·m (>= 0)",
-    ),
-    kw(
-        "WREG",
-        "ELEMENTS",
-        "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
-    ),
-    kw(
-        "PID",
-        "ELEMENTS",
-        "PID controller: a torque on a HINGE element from its angle's error to a target a·f(t)",
-    ),
-    kw("KP", "ELEMENTS", "PID: proportional gain, N·m/rad (>= 0)"),
-    kw("KI", "ELEMENTS", "PID: integral gain, N·m/(rad·s) (>= 0)"),
-    kw("KD", "ELEMENTS", "PID: derivative gain, N·m·s/rad (>= 0)"),
-    kw(
-        "TARGET",
-        "ELEMENTS",
-        "PID: function number of the target angle f(t) (exact derivatives; AMPLITUDE a scales it)",
-    ),
-    kw(
-        "CONTROL",
-        "ELEMENTS",
-        "controlled input: a torque on a HINGE (TORQUE) or a force on a node (FORCE) whose LAW is an expression of t and sensors",
-    ),
-    kw(
-        "TORQUE",
-        "ELEMENTS",
-        "CONTROL: the input is a torque about the axis of the HINGE element that follows, N·m",
-    ),
-    kw(
-        "CLEARANCE",
-        "ELEMENTS",
-        "revolute joint with radial clearance (element type; and its clearance, m)",
-    ),
-    kw("RADIUS", "ELEMENTS", "CLEARANCE: bearing radius, m"),
-    kw(
         "LAW",
         "ELEMENTS",
         "CLEARANCE: the normal force law (KV or LN); CONTROL: the input's value, an expression of t and sensors",
-    ),
-    kw("KV", "ELEMENTS", "CLEARANCE LAW: Kelvin–Voigt k c"),
-    kw(
-        "LN",
-        "ELEMENTS",
-        "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
-    ),
-    kw(
-        "EXPONENT",
-        "ELEMENTS",
-        "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
-    ),
-    kw(
-        "VMIN",
-        "ELEMENTS",
-        "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
     ),
     // functions
     kw(

@@ -29,6 +29,12 @@ pub use write::write_deck;
 use crate::model::{Model, Span};
 use std::path::Path;
 
+/// The element types of the registered kinds (`crate::kinds`: each read, written and
+/// documented by its own card), in the registry's order.
+pub fn registered_element_types() -> impl Iterator<Item = &'static str> {
+    build::types()
+}
+
 /// Parses a deck's text into a validated model, or returns every error found.
 /// `file_name` is only used in diagnostics. Never panics.
 pub fn parse_deck(source: &str, file_name: &str) -> Result<Model, DeckErrors> {

@@ -4,18 +4,14 @@
 //! generated nodes and elements are written one per line; every analysis setting is
 //! written explicitly.
 
-use crate::model::control::ControlLaw;
 use crate::model::{
-    Analysis, ContactLaw, ElementId, ElementKind, Function, Model, NodeId, PlacedProfile, Profile,
-    Scheme, Section, SectionData, Selection, SpringLength,
+    Analysis, ElementId, ElementKind, Function, Model, NodeId, Scheme, Section, SectionData,
+    Selection,
 };
-use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
 use std::fmt::Write;
 
-fn v3(v: &Vector3<f64>) -> String {
-    format!("{:?} {:?} {:?}", v.x, v.y, v.z)
-}
+use super::build::v3;
 
 fn dofs(fixed: &[bool; 6]) -> String {
     if fixed.iter().all(|f| *f) {
@@ -29,34 +25,6 @@ fn dofs(fixed: &[bool; 6]) -> String {
         .map(|(n, _)| *n)
         .collect();
     names.join(" ")
-}
-
-fn profile(p: &PlacedProfile) -> String {
-    let mut s = match &p.profile {
-        Profile::Line => "LINE".to_string(),
-        Profile::Point => "POINT".to_string(),
-        Profile::Circle { radius } => format!("CIRCLE {radius:?}"),
-        Profile::Spline { points, closed } => {
-            let mut s = String::from("SPLINE");
-            if *closed {
-                s.push_str(" CLOSED");
-            }
-            let _ = write!(s, " {}", points.len());
-            for [x, y] in points {
-                let _ = write!(s, " {x:?} {y:?}");
-            }
-            s
-        }
-    };
-    if p.offset != Vector3::zeros() {
-        let _ = write!(s, " OFFSET {}", v3(&p.offset));
-    }
-    if p.frame != Matrix3::identity() {
-        let e1: Vector3<f64> = p.frame.column(0).into();
-        let e2: Vector3<f64> = p.frame.column(1).into();
-        let _ = write!(s, " PLANE {} {}", v3(&e1), v3(&e2));
-    }
-    s
 }
 
 fn selection<T>(s: &Selection<T>, num: impl Fn(&T) -> u32) -> String {
@@ -193,6 +161,11 @@ pub fn write_deck(model: &Model) -> String {
             if gen_elements.contains(&e.id) {
                 continue;
             }
+            // A registered kind writes its own card (`crate::kinds`).
+            if super::build::write_element(model, e, &mut s) {
+                s.push('\n');
+                continue;
+            }
             let division = model.divisions.get(&e.id);
             let nodes: Vec<String> = match division {
                 Some(d) => d.ends.iter().map(|n| n.0.to_string()).collect(),
@@ -203,174 +176,33 @@ pub fn write_deck(model: &Model) -> String {
                         .map(|n| n.0.to_string())
                         .collect()
                 }
-                None => match &e.kind {
-                    ElementKind::RSpring(r) => vec![r.hinge.0.to_string()],
-                    // Its interface nodes follow INTERFACE; its modal nodes are generated.
-                    ElementKind::Superelement(_) => Vec::new(),
-                    ElementKind::Control(c) => match (c.actuator, &c.law) {
-                        (crate::model::control::Actuator::HingeTorque(h), ControlLaw::Pid(_)) => {
-                            vec![h.0.to_string()]
-                        }
-                        (crate::model::control::Actuator::HingeTorque(h), _) => {
-                            vec![format!("TORQUE {}", h.0)]
-                        }
-                        (crate::model::control::Actuator::NodeForce(n, a), _) => {
-                            vec![format!("FORCE {} {}", n.0, ["X", "Y", "Z"][a.min(2)])]
-                        }
-                    },
-                    _ => e.nodes.iter().map(|n| n.0.to_string()).collect(),
-                },
+                None => e.nodes.iter().map(|n| n.0.to_string()).collect(),
             };
+            // A BEAM (the one kind not in the registry yet).
             let _ = write!(s, "  {} {} {}", e.id.0, e.kind.keyword(), nodes.join(" "));
-            match &e.kind {
-                ElementKind::Beam {
-                    material,
-                    section,
-                    axis2,
-                    order,
-                    arc,
-                } => {
-                    if let Some(m) = material {
-                        let _ = write!(s, " MAT {}", m.0);
-                    }
-                    let _ = write!(s, " SEC {}", section.0);
-                    if let Some(a) = axis2 {
-                        let _ = write!(s, " AXIS2 {}", v3(a));
-                    }
-                    if let Some(d) = division {
-                        let _ = write!(s, " DIVIDE {}", d.count());
-                    }
-                    if *order > 1 {
-                        let _ = write!(s, " ORDER {order}");
-                    }
-                    if let Some(c) = arc {
-                        let _ = write!(s, " ARC {}", v3(c));
-                    }
+            if let ElementKind::Beam {
+                material,
+                section,
+                axis2,
+                order,
+                arc,
+            } = &e.kind
+            {
+                if let Some(m) = material {
+                    let _ = write!(s, " MAT {}", m.0);
                 }
-                ElementKind::Mass { mass, inertia } => {
-                    let _ = write!(s, " M {mass:?}");
-                    if *inertia != Matrix3::zeros() {
-                        let i = inertia;
-                        let _ = write!(
-                            s,
-                            " INERTIA {:?} {:?} {:?}",
-                            i[(0, 0)],
-                            i[(1, 1)],
-                            i[(2, 2)]
-                        );
-                        if i[(0, 1)] != 0.0 || i[(0, 2)] != 0.0 || i[(1, 2)] != 0.0 {
-                            let _ = write!(s, " {:?} {:?} {:?}", i[(0, 1)], i[(0, 2)], i[(1, 2)]);
-                        }
-                    }
+                let _ = write!(s, " SEC {}", section.0);
+                if let Some(a) = axis2 {
+                    let _ = write!(s, " AXIS2 {}", v3(a));
                 }
-                ElementKind::Hinge { axis } | ElementKind::Prismatic { axis } => {
-                    let _ = write!(s, " AXIS {}", v3(axis));
-                    if let Some(d) = model.drives.get(&e.id) {
-                        let _ = write!(s, " DRIVE {} AMPLITUDE {:?}", d.function.0, d.amplitude);
-                    }
+                if let Some(d) = division {
+                    let _ = write!(s, " DIVIDE {}", d.count());
                 }
-                ElementKind::Prescribed { motion, drive } => {
-                    match motion {
-                        crate::model::NodeMotion::Displacement(i) => {
-                            let _ = write!(s, " {}", ["X", "Y", "Z"][*i]);
-                        }
-                        crate::model::NodeMotion::Rotation(a) => {
-                            let _ = write!(s, " ROTATION AXIS {}", v3(a));
-                        }
-                    }
-                    let _ = write!(
-                        s,
-                        " FUNCTION {} AMPLITUDE {:?}",
-                        drive.function.0, drive.amplitude
-                    );
+                if *order > 1 {
+                    let _ = write!(s, " ORDER {order}");
                 }
-                ElementKind::UJoint { axis1, axis2 } => {
-                    let _ = write!(s, " AXIS1 {} AXIS2 {}", v3(axis1), v3(axis2));
-                }
-                ElementKind::Spherical | ElementKind::Clamp | ElementKind::Rigid => {}
-                ElementKind::Spring(p) => {
-                    let _ = write!(s, " K {:?} C {:?}", p.stiffness, p.damping);
-                    match p.length {
-                        SpringLength::Initial => {}
-                        SpringLength::Free(l) => {
-                            let _ = write!(s, " L0 {l:?}");
-                        }
-                        SpringLength::Preload(f) => {
-                            let _ = write!(s, " PRELOAD {f:?}");
-                        }
-                    }
-                    if let Some(f) = p.curve {
-                        let _ = write!(s, " CURVE {}", f.0);
-                    }
-                }
-                ElementKind::Bushing(b) => {
-                    let six = |v: &[f64; 6]| v.map(|x| format!("{x:?}")).join(" ");
-                    let _ = write!(s, " K {} C {}", six(&b.stiffness), six(&b.damping));
-                    if b.axes != Matrix3::identity() {
-                        let col = |i: usize| v3(&b.axes.column(i).into_owned());
-                        let _ = write!(s, " AXES {} {}", col(0), col(1));
-                    }
-                }
-                ElementKind::Superelement(d) => {
-                    let _ = write!(s, "FILES {} MODES {} INTERFACE", d.dir.display(), d.modes);
-                    for (fe, node) in d.interface.iter().zip(&e.nodes) {
-                        let _ = write!(s, " {fe} {}", node.0);
-                    }
-                }
-                ElementKind::Control(c) => match &c.law {
-                    ControlLaw::Pid(p) => {
-                        let _ = write!(
-                            s,
-                            " KP {:?} KI {:?} KD {:?} TARGET {} AMPLITUDE {:?}",
-                            p.kp, p.ki, p.kd, p.target.0, p.amplitude
-                        );
-                    }
-                    ControlLaw::Expr(e) => {
-                        let _ = write!(s, " LAW {}", e.text);
-                    }
-                    _ => {}
-                },
-                ElementKind::RSpring(r) => {
-                    let _ = write!(
-                        s,
-                        " K {:?} C {:?} THETA0 {:?} FRICTION {:?} WREG {:?}",
-                        r.stiffness, r.damping, r.angle0, r.friction, r.friction_speed
-                    );
-                }
-                ElementKind::Clearance(c) => {
-                    let law = match c.law {
-                        ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
-                        ContactLaw::LankaraniNikravesh {
-                            k,
-                            exponent,
-                            restitution,
-                        } => format!("LN {k:?} {restitution:?} EXPONENT {exponent:?}"),
-                    };
-                    let _ = write!(
-                        s,
-                        " AXIS {} RADIUS {:?} CLEARANCE {:?} LAW {law} MU {:?} VREG {:?} VMIN {:?} IMPACT_STEPS {}",
-                        v3(&c.axis),
-                        c.radius,
-                        c.clearance,
-                        c.friction,
-                        c.friction_speed,
-                        c.min_approach,
-                        c.impact_steps
-                    );
-                }
-                ElementKind::Came(c) => {
-                    let _ = write!(
-                        s,
-                        " CAM {} FOLLOWER {} K {:?} C {:?} MU {:?} VREG {:?} CLIP {} IMPACT_STEPS {}",
-                        profile(&c.cam),
-                        profile(&c.follower),
-                        c.stiffness,
-                        c.damping,
-                        c.friction,
-                        c.friction_speed,
-                        if c.clip_tension { "ON" } else { "OFF" },
-                        c.impact_steps
-                    );
+                if let Some(c) = arc {
+                    let _ = write!(s, " ARC {}", v3(c));
                 }
             }
             s.push('\n');

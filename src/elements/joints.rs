@@ -58,6 +58,7 @@
 //! warning once to standard error, and [`Joint::singularity`] returns the diagnosis (for the
 //! solver to append to a failure).
 
+use super::registry::Kind;
 use super::{BuildError, Element, ElementState, EvalContext, Local, NodeState, StateMismatch};
 use crate::dual::{Dual, Real};
 use crate::model::{self, ElementId, ElementKind, Model};
@@ -206,6 +207,39 @@ pub fn is_joint(kind: &ElementKind) -> bool {
     )
 }
 
+/// The element halves of the joint kinds (`crate::kinds`): every one a [`Joint`].
+const fn joint_kind(types: &'static [&'static str]) -> Kind {
+    Kind {
+        types,
+        build: |model, el| Ok(Box::new(Joint::from_model(model, el)?)),
+    }
+}
+
+/// `HINGE`, `PRISMATIC`.
+pub mod hinge {
+    /// Their element half.
+    pub const KIND: super::Kind = super::joint_kind(&["HINGE", "PRISMATIC"]);
+}
+
+/// `UJOINT`.
+pub mod ujoint {
+    /// Its element half.
+    pub const KIND: super::Kind = super::joint_kind(&["UJOINT"]);
+}
+
+/// `SPHERICAL`, `CLAMP`.
+pub mod spherical {
+    /// Their element half.
+    pub const KIND: super::Kind = super::joint_kind(&["SPHERICAL", "CLAMP"]);
+}
+
+/// `RIGID` (a rigid body: constraints only; a `BEAM` of `RIGID` section is a
+/// `crate::elements::rigid_bar::RigidBar`).
+pub mod rigid {
+    /// Its element half.
+    pub const KIND: super::Kind = super::joint_kind(&["RIGID"]);
+}
+
 type D12 = Dual<12>;
 
 /// `a·b`, unrolled.
@@ -335,5 +369,6 @@ mod constraints;
 mod drive;
 mod element;
 mod outputs;
+pub mod prescribed;
 #[cfg(test)]
 mod tests;

@@ -17,19 +17,18 @@
 
 pub mod beam;
 pub mod beam_p;
-pub mod bushing;
-pub mod came;
-pub mod clearance;
-pub mod control;
+pub mod bodies;
+pub mod contact;
 pub mod drive;
+pub mod forces;
 pub mod joints;
-pub mod mass;
-pub mod prescribed;
-pub mod profile;
+pub mod registry;
 pub mod rigid_bar;
-pub mod rspring;
-pub mod spring;
-pub mod superelement;
+
+pub use bodies::{mass, superelement};
+pub use contact::{came, clearance, profile};
+pub use forces::{bushing, control, rspring, spring};
+pub use joints::prescribed;
 
 use crate::model::{ElementId, ElementKind, Model};
 use nalgebra::{Matrix3, Vector3};
@@ -62,6 +61,11 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
     let mut out: Vec<Box<dyn Element>> = Vec::with_capacity(model.elements.len());
     let mut unsupported = Vec::new();
     for el in model.elements.values() {
+        // A registered kind builds its own elements (`crate::kinds`).
+        if let Some(kind) = registry::kind(el.kind.keyword()) {
+            out.push((kind.build)(model, el)?);
+            continue;
+        }
         match &el.kind {
             ElementKind::Beam { section, order, .. } => {
                 let sec = &model.sections[section];
@@ -85,54 +89,6 @@ pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
                     out.push(beam_p::from_model(model, el, nodes));
                 }
             }
-            ElementKind::Mass { mass, inertia } => {
-                out.push(Box::new(mass::PointMass::new(
-                    el.id,
-                    idx(&el.nodes[0]),
-                    *mass,
-                    *inertia,
-                )));
-            }
-            ElementKind::Came(data) => {
-                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
-                match came::Came::new(el.id, nodes, data) {
-                    Ok(c) => out.push(Box::new(c)),
-                    Err(message) => {
-                        return Err(BuildError::Invalid {
-                            element: el.id,
-                            message,
-                        });
-                    }
-                }
-            }
-            ElementKind::Prescribed { motion, drive } => {
-                let i = idx(&el.nodes[0]);
-                out.push(Box::new(prescribed::Prescribed::new(
-                    el.id,
-                    i,
-                    model.nodes[i].position,
-                    *motion,
-                    drive::TimeLaw::from_model(model, drive),
-                )));
-            }
-            ElementKind::Clearance(data) => {
-                let nodes = [idx(&el.nodes[0]), idx(&el.nodes[1])];
-                let c = clearance::Clearance::new(el.id, nodes, data).map_err(|message| {
-                    BuildError::Invalid {
-                        element: el.id,
-                        message,
-                    }
-                })?;
-                out.push(Box::new(c));
-            }
-            ElementKind::Control(data) => {
-                out.push(Box::new(control::Control::from_model(model, el, data)?))
-            }
-            k if joints::is_joint(k) => out.push(Box::new(joints::Joint::from_model(model, el)?)),
-            ElementKind::Spring(_) | ElementKind::Bushing(_) | ElementKind::RSpring(_) => {
-                out.push(spring::from_model(model, el)?)
-            }
-            ElementKind::Superelement(d) => out.push(superelement::from_model(model, el, d)?),
             other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
         }
     }

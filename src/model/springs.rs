@@ -1,7 +1,7 @@
 //! The data of the spring elements of a model (issue 25 §3): the two-node `SPRING`, the
 //! six-component `BUSHING` and the rotational spring–damper–friction `RSPRING` on a
-//! `HINGE`. What each computes is in `elements/spring.rs`, `elements/bushing.rs` and
-//! `elements/rspring.rs`; the deck syntax in grammar.md.
+//! `HINGE`. What each computes is in `elements/forces/spring.rs`, `elements/forces/bushing.rs` and
+//! `elements/forces/rspring.rs`; the deck syntax in grammar.md.
 
 use super::{ElementId, FunctionId};
 use nalgebra::{Matrix3, Vector3};

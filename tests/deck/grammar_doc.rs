@@ -64,7 +64,7 @@ fn keywords_have_docs_and_known_sections() {
         "OUTPUT",
     ];
     let mut seen = BTreeSet::new();
-    for k in KEYWORDS {
+    for k in KEYWORDS.iter() {
         assert!(is_keyword_like(k.name), "{k:?}");
         assert!(!k.doc.is_empty(), "{k:?}");
         assert!(sections.contains(&k.section), "{k:?}");

@@ -13,4 +13,5 @@ mod fuzz_regressions;
 mod grammar_doc;
 mod hostile;
 mod hostile_corpus;
+mod kinds_registry;
 mod model_props;

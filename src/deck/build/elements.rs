@@ -1,7 +1,8 @@
 //! Stage 2, ELEMENTS: beams, joints, masses, springs, contact (CAME) and profiles.
 
-use super::checks::{came_profiles, same_node, spline_points};
+use super::checks::same_node;
 use super::cursor::*;
+use super::kinds;
 use super::*;
 use crate::model::order::MAX_ORDER;
 
@@ -36,27 +37,12 @@ impl Builder<'_> {
             c.ctx = format!("elements {id} TO {l}");
             last = Some(l);
         }
-        const TYPES: [&str; 17] = [
-            "BEAM",
-            "MASS",
-            "HINGE",
-            "UJOINT",
-            "SPHERICAL",
-            "CLAMP",
-            "PRISMATIC",
-            "RIGID",
-            "CAME",
-            "SPRING",
-            "BUSHING",
-            "RSPRING",
-            "PID",
-            "CONTROL",
-            "PRESCRIBED",
-            "CLEARANCE",
-            "SUPERELEMENT",
-        ];
+        // The kinds not yet in the registry (`crate::kinds`), read below.
+        const TYPES: [&str; 1] = ["BEAM"];
         let t = c.next("element type (BEAM, MASS, HINGE, ...)")?;
-        let Some(ty) = TYPES.iter().find(|k| t.is_kw(k)).copied() else {
+        let card = kinds::card(|k| t.is_kw(k));
+        let old = TYPES.iter().find(|k| t.is_kw(k)).copied();
+        let Some(ty) = card.map(|(_, ty)| ty).or(old) else {
             return Err(DeckError::new(
                 K::UnknownElementType {
                     found: t.text.to_string(),
@@ -67,8 +53,9 @@ impl Builder<'_> {
         if last.is_some() && ty != "BEAM" {
             return Err(c.unexpected(t, "BEAM (only beams can be generated with TO)"));
         }
-        let (nodes, kind): (Vec<(u32, Span)>, ElementKind) = match ty {
-            "BEAM" => {
+        let (nodes, kind): (Vec<(u32, Span)>, ElementKind) = match (card, ty) {
+            (Some((card, ty)), _) => (card.parse)(self, &mut c, id, ty)?,
+            (None, _) => {
                 let n1 = c.uint("first node number")?;
                 let n2 = c.uint("second node number")?;
                 let mut seen = Seen::default();
@@ -158,124 +145,6 @@ impl Builder<'_> {
                     span,
                     id_span,
                 );
-            }
-            "MASS" => {
-                let n = c.uint("node number")?;
-                c.expect_keyword(&["M"], "M <mass>")?;
-                let (m, ms, mt) = c.number("M (mass)")?;
-                if m < 0.0 {
-                    return Err(out_of_range("M (mass)", mt, ">= 0 kg", ms));
-                }
-                let mut inertia = Matrix3::zeros();
-                if c.keyword(&["INERTIA"]).is_some() {
-                    let mut comp = [0.0; 6];
-                    let names = ["Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"];
-                    for (k, name) in names.iter().enumerate() {
-                        if k == 3 && !c.next_is_number() {
-                            break;
-                        }
-                        let (v, s, t) = c.number(name)?;
-                        if k < 3 && v < 0.0 {
-                            return Err(out_of_range(name, t, ">= 0 kg·m²", s));
-                        }
-                        comp[k] = v;
-                    }
-                    inertia = Matrix3::new(
-                        comp[0], comp[3], comp[4], comp[3], comp[1], comp[5], comp[4], comp[5],
-                        comp[2],
-                    );
-                }
-                c.finish()?;
-                (vec![n], ElementKind::Mass { mass: m, inertia })
-            }
-            "HINGE" | "PRISMATIC" => {
-                let n1 = c.uint("first node number")?;
-                let n2 = c.uint("second node number")?;
-                c.expect_keyword(&["AXIS"], "AXIS <x> <y> <z>")?;
-                let (axis, _, _) = c.axis(&format!("{ty} AXIS"))?;
-                if let Some(d) = self.drive_option(&mut c)? {
-                    c.finish()?;
-                    self.drives.insert(ElementId(id), d);
-                }
-                c.finish()?;
-                let kind = if ty == "HINGE" {
-                    ElementKind::Hinge { axis }
-                } else {
-                    ElementKind::Prismatic { axis }
-                };
-                (vec![n1, n2], kind)
-            }
-            "UJOINT" => {
-                let n1 = c.uint("first node number")?;
-                let n2 = c.uint("second node number")?;
-                c.expect_keyword(&["AXIS1"], "AXIS1 <x> <y> <z>")?;
-                let (a1, r1, s1) = c.axis("UJOINT AXIS1")?;
-                c.expect_keyword(&["AXIS2"], "AXIS2 <x> <y> <z>")?;
-                let (a2, r2, s2) = c.axis("UJOINT AXIS2")?;
-                c.ctx = format!("element {id} (UJOINT)");
-                Self::refuse_drive(&c)?;
-                c.finish()?;
-                let dot = r1.dot(&r2).abs() / (r1.norm() * r2.norm());
-                if dot.is_nan() || dot > 1e-6 {
-                    return Err(DeckError::new(
-                        K::UJointNotPerpendicular { element: id, dot },
-                        Span::new(s1.start, s2.end),
-                    ));
-                }
-                (
-                    vec![n1, n2],
-                    ElementKind::UJoint {
-                        axis1: a1,
-                        axis2: a2,
-                    },
-                )
-            }
-            "SPHERICAL" | "CLAMP" => {
-                let n1 = c.uint("first node number")?;
-                let n2 = c.uint("second node number")?;
-                c.ctx = format!("element {id} ({ty})");
-                Self::refuse_drive(&c)?;
-                c.finish()?;
-                let kind = if ty == "CLAMP" {
-                    ElementKind::Clamp
-                } else {
-                    ElementKind::Spherical
-                };
-                (vec![n1, n2], kind)
-            }
-            "RIGID" => {
-                c.ctx = format!("element {id} (RIGID)");
-                Self::refuse_drive(&c)?;
-                let mut ns = vec![c.uint("master node number")?, c.uint("second node number")?];
-                while c.peek().is_some() {
-                    ns.push(c.uint("node number")?);
-                }
-                (ns, ElementKind::Rigid)
-            }
-            "SPRING" => self.spring_card(&mut c, id)?,
-            "BUSHING" => Self::bushing_card(&mut c)?,
-            "RSPRING" => self.rspring_card(&mut c, id)?,
-            "PID" => self.pid_card(&mut c, id)?,
-            "CONTROL" => self.control_card(&mut c, id)?,
-            "SUPERELEMENT" => Self::superelement_card(&mut c)?,
-            "PRESCRIBED" => {
-                let (n, kind) = self.prescribed(&mut c)?;
-                (vec![n], kind)
-            }
-            "CLEARANCE" => {
-                let bearing = c.uint("bearing node number")?;
-                let journal = c.uint("journal node number")?;
-                let data = Self::clearance(&mut c)?;
-                (
-                    vec![bearing, journal],
-                    ElementKind::Clearance(Box::new(data)),
-                )
-            }
-            _ => {
-                let cam = c.uint("cam node number")?;
-                let fol = c.uint("follower node number")?;
-                let data = Self::came(&mut c, id)?;
-                (vec![cam, fol], ElementKind::Came(Box::new(data)))
             }
         };
         if ty != "BEAM" {
@@ -406,155 +275,5 @@ impl Builder<'_> {
             }
         }
         Ok(())
-    }
-
-    pub(super) fn profile(c: &mut Cursor<'_, '_>, which: &str) -> R<PlacedProfile> {
-        const TYPES: [&str; 4] = ["LINE", "POINT", "CIRCLE", "SPLINE"];
-        let (ty, _) =
-            c.expect_keyword(&TYPES, &format!("a {which} profile ({})", TYPES.join(", ")))?;
-        let ctx = format!("{which} profile");
-        let profile = match ty {
-            "LINE" => Profile::Line,
-            "POINT" => Profile::Point,
-            "CIRCLE" => Profile::Circle {
-                radius: c.number_in("CIRCLE radius", "> 0 m", |v| v > 0.0)?,
-            },
-            _ => {
-                let closed = c.keyword(&["CLOSED"]).is_some();
-                let min = if closed { 3 } else { 2 };
-                let t = c.peek();
-                let (n, ns) = c.uint("number of SPLINE points")?;
-                if (n as usize) < min {
-                    let text = t.map_or("", |t| t.text);
-                    let range = if closed {
-                        ">= 3 points for a CLOSED spline"
-                    } else {
-                        ">= 2 points"
-                    };
-                    return Err(out_of_range("number of SPLINE points", text, range, ns));
-                }
-                let mut points = Vec::new();
-                let mut spans = Vec::new();
-                for _ in 0..n {
-                    let (x, sx, _) = c.number("SPLINE point x")?;
-                    let (y, sy, _) = c.number("SPLINE point y")?;
-                    points.push([x, y]);
-                    spans.push(Span::new(sx.start, sy.end));
-                }
-                spline_points(&points, &spans, closed)?;
-                Profile::Spline { points, closed }
-            }
-        };
-        let mut offset = Vector3::zeros();
-        let mut frame = Matrix3::identity();
-        let mut angle = None;
-        let mut seen = Seen::default();
-        let kws: &[&'static str] = if ty == "LINE" {
-            &["OFFSET", "PLANE", "ANGLE"]
-        } else {
-            &["OFFSET", "PLANE"]
-        };
-        while let Some((kw, ks)) = c.keyword(kws) {
-            seen.add(kw, ks, &ctx)?;
-            match kw {
-                "OFFSET" => offset = c.vec3("OFFSET")?.0,
-                "ANGLE" => angle = Some(c.number("ANGLE (degrees)")?.0),
-                _ => {
-                    let (e1, _, _) = c.axis("PLANE e1")?;
-                    let (e2, _, s2) = c.axis("PLANE e2")?;
-                    let d = e1.dot(&e2);
-                    let e2 = if d.abs() <= 1e-12 { e2 } else { e2 - e1 * d };
-                    let e2 = unit(e2).filter(|v| v.cross(&e1).norm() > 1e-9);
-                    let Some(e2) = e2 else {
-                        return Err(DeckError::new(
-                            K::PlaneParallel,
-                            Span::new(ks.start, s2.end),
-                        ));
-                    };
-                    frame = Matrix3::from_columns(&[e1, e2, e1.cross(&e2)]);
-                }
-            }
-        }
-        if let Some(deg) = angle {
-            let (s, co) = deg.to_radians().sin_cos();
-            let c1: Vector3<f64> = frame.column(0).into();
-            let c2: Vector3<f64> = frame.column(1).into();
-            let n1 = c1 * co + c2 * s;
-            let n2 = c2 * co - c1 * s;
-            frame = Matrix3::from_columns(&[n1, n2, n1.cross(&n2)]);
-        }
-        Ok(PlacedProfile {
-            profile,
-            offset,
-            frame,
-        })
-    }
-
-    pub(super) fn came(c: &mut Cursor<'_, '_>, id: u32) -> R<CameData> {
-        const KW: [&str; 8] = [
-            "CAM",
-            "FOLLOWER",
-            "K",
-            "C",
-            "MU",
-            "VREG",
-            "CLIP",
-            "IMPACT_STEPS",
-        ];
-        let mut seen = Seen::default();
-        let mut fol_span = c.end_span();
-        let (mut cam, mut fol, mut k) = (None, None, None);
-        let (mut damping, mut mu, mut vreg, mut clip, mut steps) = (0.0, 0.0, 1e-3, true, 10);
-        while let Some(t) = c.peek() {
-            let Some((kw, ks)) = c.keyword(&KW) else {
-                return Err(c.unexpected(t, &expected_list(&KW)));
-            };
-            seen.add(kw, ks, &c.ctx)?;
-            match kw {
-                "CAM" => cam = Some(Self::profile(c, "CAM")?),
-                "FOLLOWER" => {
-                    fol_span = ks;
-                    fol = Some(Self::profile(c, "FOLLOWER")?);
-                }
-                "K" => k = Some(c.number_in("K (contact stiffness)", "> 0 N/m", |v| v > 0.0)?),
-                "C" => damping = c.number_in("C (contact damping)", ">= 0 N·s/m", |v| v >= 0.0)?,
-                "MU" => mu = c.number_in("MU (friction coefficient)", ">= 0", |v| v >= 0.0)?,
-                "VREG" => vreg = c.number_in("VREG (friction speed)", "> 0 m/s", |v| v > 0.0)?,
-                "CLIP" => {
-                    clip = c.expect_keyword(&["ON", "OFF"], "ON or OFF after CLIP")?.0 == "ON"
-                }
-                _ => {
-                    let (n, s) = c.uint("IMPACT_STEPS")?;
-                    if n < 1 {
-                        return Err(out_of_range("IMPACT_STEPS", "0", ">= 1", s));
-                    }
-                    steps = n;
-                }
-            }
-        }
-        let miss = |what: &str| {
-            DeckError::new(
-                K::MissingKeyword {
-                    context: c.ctx.clone(),
-                    expected: what.into(),
-                },
-                c.end_span(),
-            )
-        };
-        let (cam, fol) = (
-            cam.ok_or_else(|| miss("CAM <profile>"))?,
-            fol.ok_or_else(|| miss("FOLLOWER <profile>"))?,
-        );
-        came_profiles(id, &cam.profile, &fol.profile, fol_span)?;
-        Ok(CameData {
-            stiffness: k.ok_or_else(|| miss("K <contact stiffness>"))?,
-            damping,
-            friction: mu,
-            friction_speed: vreg,
-            clip_tension: clip,
-            impact_steps: steps,
-            cam,
-            follower: fol,
-        })
     }
 }

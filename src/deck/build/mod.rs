@@ -3,17 +3,18 @@
 
 mod analysis;
 mod checks;
-mod clearance;
 mod control;
 mod cursor;
 mod drives;
 mod elements;
 mod functions;
+mod kinds;
 mod nodes;
 mod properties;
 mod section;
 mod springs;
-mod superelement;
+
+pub(super) use kinds::{rows, types, v3, write_element};
 
 use super::cards::{Card, Section};
 use super::error::{DeckError, DeckErrorKind as K, line_col};

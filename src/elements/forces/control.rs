@@ -33,10 +33,13 @@
 //! The input's power `u ḋ` (`u θ̇`, `u v_a`) counts as external work in the energy balance
 //! ([`Element::input_power`]), so the energy guard pays for what a controller puts in.
 
-use super::joints::normals;
-use super::{Element, ElementState, EvalContext, Local, NodeState, StateMismatch, rx, tx};
 use crate::dual::{Dual, Real};
 use crate::elements::drive::TimeLaw;
+use crate::elements::joints::normals;
+use crate::elements::registry::{Kind, not_mine};
+use crate::elements::{
+    Element, ElementState, EvalContext, Local, NodeState, StateMismatch, rx, tx,
+};
 use crate::model::control::{Actuator, ControlData, ControlLaw, Law, Sensor};
 use crate::model::{ElementId, ElementKind, Model, NodeId};
 use crate::rotation::{c, mm, mtm, mtv, mv, skew};
@@ -74,6 +77,15 @@ enum Resolved {
     External(Arc<dyn Law>),
     Expr(crate::model::Expr),
 }
+
+/// The element half of `PID` and `CONTROL` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["PID", "CONTROL"],
+    build: |model, el| match &el.kind {
+        ElementKind::Control(data) => Ok(Box::new(Control::from_model(model, el, data)?)),
+        _ => Err(not_mine(el, "CONTROL")),
+    },
+};
 
 /// The controlled input element (see the module docs).
 pub struct Control {
@@ -174,8 +186,8 @@ impl Control {
         model: &Model,
         el: &crate::model::Element,
         data: &ControlData,
-    ) -> Result<Self, super::BuildError> {
-        let invalid = |message: String| super::BuildError::Invalid {
+    ) -> Result<Self, crate::elements::BuildError> {
+        let invalid = |message: String| crate::elements::BuildError::Invalid {
             element: el.id,
             message,
         };
@@ -186,14 +198,14 @@ impl Control {
                 .ok_or_else(|| invalid(format!("node {} does not exist", n.0)))
         };
         let nodes: Vec<usize> = el.nodes.iter().map(dense_of).collect::<Result<_, _>>()?;
-        let local = |n: &NodeId| -> Result<usize, super::BuildError> {
+        let local = |n: &NodeId| -> Result<usize, crate::elements::BuildError> {
             let d = dense_of(n)?;
             nodes
                 .iter()
                 .position(|x| *x == d)
                 .ok_or_else(|| invalid(format!("node {} is not one of the input's nodes", n.0)))
         };
-        let hinge = |h: ElementId| -> Result<HingeAt, super::BuildError> {
+        let hinge = |h: ElementId| -> Result<HingeAt, crate::elements::BuildError> {
             match model.elements.get(&h) {
                 Some(e) => match &e.kind {
                     ElementKind::Hinge { axis } => {

@@ -26,13 +26,20 @@
 //!
 //! Energy: `U = ½ uᵀK_u u + ½ φᵀK_φ φ`; dissipated power `ẏᵀCẏ`.
 
-use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::dual::{Dual, Real};
+use crate::elements::registry::Kind;
+use crate::elements::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::model::{BushingData, ElementId};
 use crate::rotation::{self, c, mm, mtm, mtv, mv, skew};
 use nalgebra::{Matrix3, Vector3};
 
 type D12 = Dual<12>;
+
+/// The element half of `BUSHING` (`crate::kinds`): built by [`super::from_model`].
+pub const KIND: Kind = Kind {
+    types: &["BUSHING"],
+    build: super::from_model,
+};
 
 /// A BUSHING element (see the module docs).
 #[derive(Debug, Clone)]

@@ -1,13 +1,78 @@
-//! Stage 2, ELEMENTS: the `CLEARANCE` card (a revolute joint with radial clearance).
+//! `CLEARANCE <bearing> <journal> AXIS … RADIUS … CLEARANCE … LAW …`: a revolute joint
+//! with radial clearance (grammar.md, "Elements").
 
-use super::cursor::*;
-use super::*;
+use super::super::v3;
+use super::super::{Card, row};
+use crate::deck::build::cursor::*;
+use crate::deck::build::*;
 use crate::model::{ClearanceData, ContactLaw};
+use std::fmt::Write;
+
+/// The deck half of `CLEARANCE`.
+pub(in crate::deck::build) const CARD: Card = Card {
+    types: &["CLEARANCE"],
+    rows: &[
+        row(
+            "CLEARANCE",
+            "revolute joint with radial clearance (element type; and its clearance, m)",
+        ),
+        row("RADIUS", "CLEARANCE: bearing radius, m"),
+        row("KV", "CLEARANCE LAW: Kelvin–Voigt k c"),
+        row(
+            "LN",
+            "CLEARANCE LAW: Lankarani–Nikravesh K e (Hertz with hysteresis damping)",
+        ),
+        row(
+            "EXPONENT",
+            "CLEARANCE LAW LN: Hertz exponent n (> 0, default 1.5)",
+        ),
+        row(
+            "VMIN",
+            "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
+        ),
+    ],
+    parse: |_, c, _, _| {
+        let bearing = c.uint("bearing node number")?;
+        let journal = c.uint("journal node number")?;
+        let data = Builder::clearance(c)?;
+        Ok((
+            vec![bearing, journal],
+            ElementKind::Clearance(Box::new(data)),
+        ))
+    },
+    write,
+};
+
+fn write(_: &Model, e: &Element, s: &mut String) {
+    s.push_str(&super::super::node_list(e));
+    let ElementKind::Clearance(c) = &e.kind else {
+        return;
+    };
+    let law = match c.law {
+        ContactLaw::KelvinVoigt { k, c } => format!("KV {k:?} {c:?}"),
+        ContactLaw::LankaraniNikravesh {
+            k,
+            exponent,
+            restitution,
+        } => format!("LN {k:?} {restitution:?} EXPONENT {exponent:?}"),
+    };
+    let _ = write!(
+        s,
+        " AXIS {} RADIUS {:?} CLEARANCE {:?} LAW {law} MU {:?} VREG {:?} VMIN {:?} IMPACT_STEPS {}",
+        v3(&c.axis),
+        c.radius,
+        c.clearance,
+        c.friction,
+        c.friction_speed,
+        c.min_approach,
+        c.impact_steps
+    );
+}
 
 impl Builder<'_> {
     /// `CLEARANCE <bearing> <journal> AXIS x y z RADIUS R CLEARANCE c LAW (KV k c | LN K e
     /// [EXPONENT n]) [MU μ] [VREG v] [VMIN v] [IMPACT_STEPS n]`, keywords in any order.
-    pub(super) fn clearance(c: &mut Cursor<'_, '_>) -> R<ClearanceData> {
+    fn clearance(c: &mut Cursor<'_, '_>) -> R<ClearanceData> {
         const KW: [&str; 9] = [
             "AXIS",
             "RADIUS",
@@ -137,7 +202,7 @@ impl Builder<'_> {
 /// `n ≥ 1 − ln(MAX/K)/ln(1/δ₀)`; with `c ≥ 1` the force at `c` must not overflow,
 /// `n ≤ ln(MAX/K)/ln c`. (K = 6.6e10 N/m^1.5, c = 0.5 mm: n in [0, 16.8]; the issue's
 /// `EXPONENT 1e308` let the journal 0.7 mm past its clearance with a force of 0.)
-pub(super) fn exponent_range(k: f64, c: f64) -> (f64, f64) {
+fn exponent_range(k: f64, c: f64) -> (f64, f64) {
     let d0 = f64::EPSILON * c;
     let (ln_min, ln_max) = (f64::MIN_POSITIVE.ln(), f64::MAX.ln());
     let mut hi = f64::INFINITY;

@@ -3,8 +3,8 @@ use crate::elements::testing::*;
 use crate::model::FunctionId;
 use crate::model::control::{HeldValue, Pid};
 
-const PENDULUM: &str = include_str!("../../../decks/simple_pendulum.dat");
-const ARM: &str = include_str!("../../../decks/driven_arm.dat");
+const PENDULUM: &str = include_str!("../../../../decks/simple_pendulum.dat");
+const ARM: &str = include_str!("../../../../decks/driven_arm.dat");
 
 /// A smooth nonlinear law of four sensors, with its exact gradient.
 struct Smooth;

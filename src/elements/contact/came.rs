@@ -56,7 +56,9 @@
 //! check (exact for lines and circles, a bounding circle for closed splines).
 
 use super::profile::Curve;
-use crate::model::{CameData, ElementId, Profile};
+use crate::elements::BuildError;
+use crate::elements::registry::{Kind, node_index, not_mine};
+use crate::model::{CameData, ElementId, ElementKind, Profile};
 use nalgebra::{Matrix3, Vector3};
 use num_dual::DualSVec64;
 use std::sync::atomic::AtomicU64;
@@ -100,6 +102,27 @@ pub struct ContactState<S> {
     /// Friction force on the roller body.
     pub friction: Vector3<S>,
 }
+
+/// The element half of `CAME` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["CAME"],
+    build: |model, el| {
+        let ElementKind::Came(data) = &el.kind else {
+            return Err(not_mine(el, "CAME"));
+        };
+        let nodes = [
+            node_index(model, &el.nodes[0]),
+            node_index(model, &el.nodes[1]),
+        ];
+        match Came::new(el.id, nodes, data) {
+            Ok(c) => Ok(Box::new(c)),
+            Err(message) => Err(BuildError::Invalid {
+                element: el.id,
+                message,
+            }),
+        }
+    },
+};
 
 /// The CAME element.
 #[derive(Debug)]

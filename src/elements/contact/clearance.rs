@@ -47,10 +47,31 @@
 //! anti-chatter memory of the active set shared with CAME. The tangent is exact: the
 //! kernel is generic in the scalar and differentiated by dual numbers in 12 directions.
 
+use crate::elements::BuildError;
 use crate::elements::came::law::ActiveSetMemory;
-use crate::model::{ClearanceData, ContactLaw, ElementId};
+use crate::elements::registry::{Kind, node_index, not_mine};
+use crate::model::{ClearanceData, ContactLaw, ElementId, ElementKind};
 use nalgebra::Vector3;
 use std::sync::atomic::AtomicU64;
+
+/// The element half of `CLEARANCE` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["CLEARANCE"],
+    build: |model, el| {
+        let ElementKind::Clearance(data) = &el.kind else {
+            return Err(not_mine(el, "CLEARANCE"));
+        };
+        let nodes = [
+            node_index(model, &el.nodes[0]),
+            node_index(model, &el.nodes[1]),
+        ];
+        let c = Clearance::new(el.id, nodes, data).map_err(|message| BuildError::Invalid {
+            element: el.id,
+            message,
+        })?;
+        Ok(Box::new(c))
+    },
+};
 
 /// The CLEARANCE element (nodes: bearing, journal).
 #[derive(Debug)]

@@ -22,9 +22,10 @@ pub mod reduce;
 #[cfg(test)]
 mod tests;
 
-use super::{BuildError, Element, Energies, EvalContext, Local, NodeState, RotationUse};
 use crate::dual::Dual;
-use crate::model::{ElementId, Model, SuperelementData};
+use crate::elements::registry::{Kind, not_mine};
+use crate::elements::{BuildError, Element, Energies, EvalContext, Local, NodeState, RotationUse};
+use crate::model::{ElementId, ElementKind, Model, SuperelementData};
 use invariants::Body;
 use kernel::{Layout, Pre, State};
 use nalgebra::{Matrix3, Vector3};
@@ -296,6 +297,15 @@ impl Superelement {
         }
     }
 }
+
+/// The element half of `SUPERELEMENT` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["SUPERELEMENT"],
+    build: |model, el| match &el.kind {
+        ElementKind::Superelement(d) => from_model(model, el, d),
+        _ => Err(not_mine(el, "SUPERELEMENT")),
+    },
+};
 
 /// Builds a model's `SUPERELEMENT`.
 pub fn from_model(

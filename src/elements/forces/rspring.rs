@@ -27,14 +27,23 @@
 //! `T_θ̇ = c + (T_f/ω_reg)(1 − tanh²(θ̇/ω_reg))` and `∂g/∂q` by dual numbers ([`Dual<6>`]
 //! seeding `Rᵢ(I + ε̃)`).
 
-use super::joints::normals;
-use super::{Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, rx};
 use crate::dual::{Dual, Real};
+use crate::elements::joints::normals;
+use crate::elements::registry::Kind;
+use crate::elements::{
+    Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, rx,
+};
 use crate::model::{ElementId, RSpringData};
 use crate::rotation::{c, mm, mtm, mtv, mv, skew};
 use nalgebra::{Matrix3, Vector3, Vector6};
 
 type D6 = Dual<6>;
+
+/// The element half of `RSPRING` (`crate::kinds`): built by [`super::from_model`].
+pub const KIND: Kind = Kind {
+    types: &["RSPRING"],
+    build: super::from_model,
+};
 
 /// An RSPRING element (see the module docs).
 #[derive(Debug, Clone)]

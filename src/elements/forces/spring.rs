@@ -30,11 +30,18 @@
 //! Newton reports a non-finite solution, the step is cut, and a run that cannot avoid the
 //! passage fails with this element's diagnosis ([`Element::diagnose`]).
 
-use super::{
+use crate::elements::registry::Kind;
+use crate::elements::{
     BuildError, Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch, tx,
 };
-use crate::model::{self, ElementId, ElementKind, Function, Model, SpringData, SpringLength};
+use crate::model::{ElementId, Function, SpringData, SpringLength};
 use nalgebra::{Matrix3, Vector3};
+
+/// The element half of `SPRING` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["SPRING"],
+    build: from_model,
+};
 
 /// A SPRING element (see the module docs).
 #[derive(Debug, Clone)]
@@ -345,38 +352,7 @@ impl Element for Spring {
     }
 }
 
-/// Builds a SPRING, BUSHING or RSPRING of the model (the spring family of issue 25 §3).
-pub fn from_model(model: &Model, el: &model::Element) -> Result<Box<dyn Element>, BuildError> {
-    let idx = |k: usize| {
-        model
-            .nodes
-            .get_index_of(&el.nodes[k])
-            .expect("validated model: nodes exist")
-    };
-    let (nodes, x0) = if el.nodes.len() == 2 {
-        let n = [idx(0), idx(1)];
-        (n, [model.nodes[n[0]].position, model.nodes[n[1]].position])
-    } else {
-        return Err(BuildError::Invalid {
-            element: el.id,
-            message: format!("{} joins exactly two nodes", el.kind.keyword()),
-        });
-    };
-    Ok(match &el.kind {
-        ElementKind::Spring(d) => {
-            let curve = d.curve.map(|f| model.functions[&f].function.clone());
-            Box::new(Spring::new(el.id, nodes, x0, d, curve)?)
-        }
-        ElementKind::Bushing(d) => Box::new(super::bushing::Bushing::new(el.id, nodes, x0, d)),
-        ElementKind::RSpring(d) => Box::new(super::rspring::RSpring::new(el.id, nodes, d)),
-        other => {
-            return Err(BuildError::Invalid {
-                element: el.id,
-                message: format!("{} is not a spring", other.keyword()),
-            });
-        }
-    })
-}
+pub use super::from_model;
 
 /// Places the node-2 block `k` of a two-node element whose node-1 rows and columns are its
 /// negatives: `[k, −k; −k, k]` on the translations.

@@ -4,10 +4,25 @@
 //! frame; `J` is given in the global frame at t = 0, where the node frame is the global one).
 //! Iteration matrix: `c_a m I` and `c_a J + c_v (Ω̃ J − (JΩ)~)`.
 
-use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
-use crate::model::ElementId;
+use crate::elements::registry::{Kind, node_index, not_mine};
+use crate::elements::{BuildError, Element, Energies, EvalContext, Local, NodeState, rx, tx};
+use crate::model::{self, ElementId, ElementKind, Model};
 use crate::rotation::skew;
 use nalgebra::{Matrix3, Vector3};
+
+/// The element half of `MASS` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["MASS"],
+    build,
+};
+
+fn build(model: &Model, el: &model::Element) -> Result<Box<dyn Element>, BuildError> {
+    let ElementKind::Mass { mass, inertia } = &el.kind else {
+        return Err(not_mine(el, "MASS"));
+    };
+    let node = node_index(model, &el.nodes[0]);
+    Ok(Box::new(PointMass::new(el.id, node, *mass, *inertia)))
+}
 
 /// A point mass on one node.
 #[derive(Debug, Clone)]

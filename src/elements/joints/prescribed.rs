@@ -19,15 +19,34 @@
 //! Outputs (`element_<N>.csv`): `prescribed` (`a f(t)`), `displacement` (`xᵢ − xᵢ⁰`, m) or
 //! `angle` (rad, counted past ±π), and the driver's `force` (N) or `moment` (N·m).
 
-use super::drive::TimeLaw;
-use super::{Element, EvalContext, Local, NodeState};
 use crate::dual::{Dual, Real};
-use crate::model::{ElementId, NodeMotion};
+use crate::elements::drive::TimeLaw;
+use crate::elements::registry::{Kind, node_index, not_mine};
+use crate::elements::{Element, EvalContext, Local, NodeState};
+use crate::model::{ElementId, ElementKind, NodeMotion};
 use crate::rotation::{c, mm, mtv, mv, skew};
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::TAU;
 
 type D3 = Dual<3>;
+
+/// The element half of `PRESCRIBED` (`crate::kinds`).
+pub const KIND: Kind = Kind {
+    types: &["PRESCRIBED"],
+    build: |model, el| {
+        let ElementKind::Prescribed { motion, drive } = &el.kind else {
+            return Err(not_mine(el, "PRESCRIBED"));
+        };
+        let i = node_index(model, &el.nodes[0]);
+        Ok(Box::new(Prescribed::new(
+            el.id,
+            i,
+            model.nodes[i].position,
+            *motion,
+            TimeLaw::from_model(model, drive),
+        )))
+    },
+};
 
 /// A prescribed node motion.
 #[derive(Debug, Clone)]
@@ -59,7 +78,7 @@ impl Prescribed {
         law: TimeLaw,
     ) -> Self {
         let (p, q) = match motion {
-            NodeMotion::Rotation(n) => super::joints::normals(&n),
+            NodeMotion::Rotation(n) => super::normals(&n),
             NodeMotion::Displacement(_) => (Vector3::x(), Vector3::y()),
         };
         let motion = match motion {

@@ -1,0 +1,4 @@
+//! Bodies: point masses, rigid bodies, superelements.
+
+pub(super) mod mass;
+pub(super) mod superelement;
