@@ -70,12 +70,12 @@ pub enum DeckErrorKind {
         expected: String,
     },
     /// An unknown element type.
-    #[error(
-        "unknown element type `{found}`: expected one of BEAM, MASS, HINGE, UJOINT, SPHERICAL, CLAMP, PRISMATIC, RIGID, CAME, CLEARANCE, SPRING, BUSHING, RSPRING"
-    )]
+    #[error("unknown element type `{found}`: expected one of {expected}")]
     UnknownElementType {
         /// The word.
         found: String,
+        /// The element types the deck reads (the registry's, `crate::kinds`), by commas.
+        expected: String,
     },
     /// A token where a number is due is not a number.
     #[error("expected {expected}, found `{found}` (not a number)")]

@@ -103,3 +103,19 @@ fn every_registered_kind_round_trips_through_the_writer() {
         }
     }
 }
+
+#[test]
+fn an_unknown_element_type_lists_every_registered_type() {
+    let deck = "TITLE a typo\nNODES\n  1 0 0 0\n  2 1 0 0\nELEMENTS\n  1 BEEM 1 2 SEC 1\n\
+                ANALYSIS DYNAMIC STEP 0.01 END 0.1\nEND\n";
+    let e = parse_deck(deck, "typo.dat").expect_err("BEEM is no element type");
+    let msg = e.to_string();
+    assert!(msg.contains("`BEEM`"), "{msg}");
+    for ty in registered_element_types().chain(["BEAM"]) {
+        assert!(
+            msg.split(|c: char| !c.is_ascii_alphanumeric())
+                .any(|w| w == ty),
+            "{ty} missing from: {msg}"
+        );
+    }
+}

@@ -43,9 +43,11 @@ impl Builder<'_> {
         let card = kinds::card(|k| t.is_kw(k));
         let old = TYPES.iter().find(|k| t.is_kw(k)).copied();
         let Some(ty) = card.map(|(_, ty)| ty).or(old) else {
+            let types: Vec<&str> = TYPES.into_iter().chain(kinds::types()).collect();
             return Err(DeckError::new(
                 K::UnknownElementType {
                     found: t.text.to_string(),
+                    expected: types.join(", "),
                 },
                 t.span,
             ));

@@ -31,7 +31,7 @@ impl DeckErrorKind {
             K::UnknownSection { found, .. }
             | K::CardOutsideSection { found, .. }
             | K::UnknownKeyword { found, .. }
-            | K::UnknownElementType { found }
+            | K::UnknownElementType { found, .. }
             | K::ExpectedNumber { found, .. }
             | K::ExpectedInteger { found, .. }
             | K::NonFinite { found, .. }
