@@ -151,8 +151,10 @@ def build(mbs, contact_mode="switch"):
     mbs.AddLoad(LoadTorqueVector(markerNumber=m2t, loadVector=[0.0, 0.0, 0.0],
                                  loadVectorUserFunction=torque))
 
-    # element 23, CAME: floor y = -1.8, point follower at node 23, penalty with dashpot,
-    # F_y = max(0, -k g - c g') while g = y23 + 1.8 < 0, no friction; a user-function load.
+    # element 23, CAME ... CLIP OFF: floor y = -1.8, point follower at node 23, penalty with
+    # dashpot, F_y = -k g - c g' while g = y23 + 1.8 < 0 (the tensile part of the dashpot's
+    # force included: the deck's CLIP OFF; a clipped law, F_y = max(0, ...), is CLIP ON's),
+    # no friction; a user-function load.
     #   contact="implicit": the law above evaluated at every Newton iterate (as mecano-rs);
     #     Newton can cycle between the branches at an impact step (it does at h = 1e-3).
     #   contact="switch" (default): Exudyn's own way for such laws: the active flag is frozen
@@ -175,7 +177,7 @@ def build(mbs, contact_mode="switch"):
     if contact_mode == "implicit":
         def contact(mbs_, t, load):
             gap, f = law(mbs_)
-            return [0.0, f if f > 0.0 else 0.0, 0.0]
+            return [0.0, f, 0.0]
     else:
         def contact(mbs_, t, load):
             if not flag["active"]:
@@ -185,7 +187,7 @@ def build(mbs, contact_mode="switch"):
 
         def post_newton(mbs_, t):
             gap, f = law(mbs_)
-            new = gap < 0.0 and f > 0.0
+            new = gap < 0.0
             if new != flag["active"]:
                 flag["active"] = new
                 flag["switches"] += 1
