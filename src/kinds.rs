@@ -12,13 +12,13 @@
 //!
 //! Each stage expands this one list into its own table ([`element_kinds`] calls back the
 //! stage's macro with the list), so a new kind is its halves plus one line here; the deck
-//! never names `elements` and `elements` never names `deck`. Kinds not yet listed here
-//! are read and built by the former code paths (ARCHITECTURE.md says which).
+//! never names `elements` and `elements` never names `deck`. Every element kind is listed here.
 
 /// Calls `$then! { family::kind, … }` with every registered kind.
 macro_rules! element_kinds {
     ($then:ident) => {
         $then! {
+            beams::beam,
             bodies::mass,
             bodies::superelement,
             contact::came,

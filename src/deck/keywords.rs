@@ -207,32 +207,6 @@ const ROWS: &[KeywordDoc] = &[
     kw("RZ", "NODES", "rotation about global Z"),
     // elements
     kw(
-        "BEAM",
-        "ELEMENTS",
-        "geometrically exact beam (two nodes, or p + 1 with ORDER)",
-    ),
-    kw(
-        "MAT",
-        "ELEMENTS",
-        "material number of a BEAM (none for a section of PROPERTIES)",
-    ),
-    kw("SEC", "ELEMENTS", "section number of a BEAM"),
-    kw(
-        "DIVIDE",
-        "ELEMENTS",
-        "BEAM: divide into n equal elements, nodes generated on the axis",
-    ),
-    kw(
-        "ORDER",
-        "ELEMENTS",
-        "BEAM: polynomial order p, p - 1 nodes generated at the GLL points",
-    ),
-    kw(
-        "ARC",
-        "ELEMENTS",
-        "BEAM: centre of the circular arc that is the reference axis",
-    ),
-    kw(
         "AXIS2",
         "ELEMENTS",
         "BEAM: local axis 2 direction; UJOINT: axis on the second node",

@@ -15,22 +15,21 @@
 //! iteration matrix `S = ∂r/∂q + c_v ∂r/∂v + c_a ∂r/∂a` (derivatives with respect to
 //! `[δx, δΘ]`, velocities and accelerations), the coefficients coming from the integrator.
 
-pub mod beam;
-pub mod beam_p;
+pub mod beams;
 pub mod bodies;
 pub mod contact;
 pub mod drive;
 pub mod forces;
 pub mod joints;
 pub mod registry;
-pub mod rigid_bar;
 
+pub use beams::beam::{beam_p, rigid_bar, two_node as beam};
 pub use bodies::{mass, superelement};
 pub use contact::{came, clearance, profile};
 pub use forces::{bushing, control, rspring, spring};
 pub use joints::prescribed;
 
-use crate::model::{ElementId, ElementKind, Model};
+use crate::model::{ElementId, Model};
 use nalgebra::{Matrix3, Vector3};
 
 /// Errors while turning model elements into solver elements.
@@ -52,44 +51,13 @@ pub enum BuildError {
 
 /// Builds the solver's elements from a validated model, in model order.
 pub fn build(model: &Model) -> Result<Vec<Box<dyn Element>>, BuildError> {
-    let idx = |id| {
-        model
-            .nodes
-            .get_index_of(id)
-            .expect("validated model: nodes exist")
-    };
     let mut out: Vec<Box<dyn Element>> = Vec::with_capacity(model.elements.len());
     let mut unsupported = Vec::new();
     for el in model.elements.values() {
-        // A registered kind builds its own elements (`crate::kinds`).
-        if let Some(kind) = registry::kind(el.kind.keyword()) {
-            out.push((kind.build)(model, el)?);
-            continue;
-        }
-        match &el.kind {
-            ElementKind::Beam { section, order, .. } => {
-                let sec = &model.sections[section];
-                let nodes: Vec<usize> = el.nodes.iter().map(idx).collect();
-                if *order as usize > beam_p::MAX_ORDER
-                    || (nodes.len() != 2 && nodes.len() != *order as usize + 1)
-                {
-                    return Err(BuildError::Invalid {
-                        element: el.id,
-                        message: format!(
-                            "a beam of order {order} (at most {}) needs 2 or {} nodes, it has {}",
-                            beam_p::MAX_ORDER,
-                            order + 1,
-                            nodes.len()
-                        ),
-                    });
-                }
-                if sec.rigid {
-                    out.push(Box::new(rigid_bar::RigidBar::from_model(model, el, nodes)?));
-                } else {
-                    out.push(beam_p::from_model(model, el, nodes));
-                }
-            }
-            other => unsupported.push(format!("{} ({})", el.id, other.keyword())),
+        // Each kind builds its own elements (`crate::kinds`).
+        match registry::kind(el.kind.keyword()) {
+            Some(kind) => out.push((kind.build)(model, el)?),
+            None => unsupported.push(format!("{} ({})", el.id, el.kind.keyword())),
         }
     }
     if unsupported.is_empty() {

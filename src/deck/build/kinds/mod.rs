@@ -9,6 +9,7 @@ use crate::deck::KeywordDoc;
 use crate::model::{Element, ElementKind, Model, Span};
 use std::fmt::Write;
 
+mod beams;
 mod bodies;
 mod contact;
 mod forces;
@@ -25,11 +26,42 @@ pub(super) struct Card {
     /// `ELEMENTS`), hence of `grammar.md`. Keywords several kinds share (`K`, `C`, `AXIS`,
     /// …) stay in `deck/keywords.rs`.
     pub(super) rows: &'static [KeywordDoc],
-    /// Reads the card after its type word: `(builder, cursor, element number, type)`.
-    pub(super) parse: fn(&mut Builder<'_>, &mut Cursor<'_, '_>, u32, &'static str) -> R<Parsed>,
+    /// Reads the card after its type word.
+    pub(super) parse: Parse,
     /// Writes the card after `<number> <TYPE> `: its nodes and fields, as `parse` reads
     /// them back (`parse ∘ write = id`).
     pub(super) write: fn(&Model, &Element, &mut String),
+}
+
+/// How a card is read after its type word.
+#[derive(Clone, Copy)]
+pub(super) enum Parse {
+    /// One element, `(builder, cursor, element number, type)` → its nodes and kind; the
+    /// element loop checks and adds it. A `TO` generation is refused for it.
+    One(fn(&mut Builder<'_>, &mut Cursor<'_, '_>, u32, &'static str) -> R<Parsed>),
+    /// A card that adds its own elements: the `first TO last` generation (`last = first`
+    /// without `TO`), and whatever it generates besides (a BEAM's DIVIDE).
+    Generates(fn(&mut Builder<'_>, &mut Cursor<'_, '_>, &Generation) -> R<()>),
+}
+
+/// The element numbers and spans of a card that adds its own elements.
+pub(super) struct Generation {
+    /// First and last element numbers (equal without `TO`).
+    pub(super) first: u32,
+    pub(super) last: u32,
+    /// The whole card, and its element number (or `first TO last`).
+    pub(super) span: Span,
+    pub(super) id_span: Span,
+}
+
+/// The element types that a `TO` generation accepts, by commas.
+pub(super) fn generated_types() -> String {
+    let t: Vec<&str> = CARDS
+        .iter()
+        .filter(|c| matches!(c.parse, Parse::Generates(_)))
+        .flat_map(|c| c.types.iter().copied())
+        .collect();
+    t.join(", ")
 }
 
 macro_rules! cards {

@@ -1,7 +1,7 @@
 //! `MASS <node> M <m> [INERTIA Ixx Iyy Izz [Ixy Ixz Iyz]]`: a point mass with its rotary
 //! inertia (grammar.md, "Elements").
 
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use std::fmt::Write;
@@ -17,7 +17,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "rotary inertia of a MASS, kg·m², global frame at t = 0",
         ),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

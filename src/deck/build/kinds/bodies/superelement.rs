@@ -1,7 +1,7 @@
 //! `SUPERELEMENT FILES <dir> MODES <n> INTERFACE <fe> <node> …`: a linear elastic body
 //! reduced from an FE model (issue 38; grammar.md, "Superelements").
 
-use super::super::{Card, Parsed, row};
+use super::super::{Card, Parse, Parsed, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use crate::model::SuperelementData;
@@ -24,7 +24,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "SUPERELEMENT: pairs <FE node> <node>; the first is the frame node",
         ),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

@@ -3,7 +3,7 @@
 //! (grammar.md, "Elements").
 
 use super::super::v3;
-use super::super::{Card, node_list, row};
+use super::super::{Card, Parse, node_list, row};
 use crate::deck::build::checks::{came_profiles, spline_points};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
@@ -32,12 +32,12 @@ pub(in crate::deck::build) const CARD: Card = Card {
         row("ON", "CLIP ON"),
         row("OFF", "CLIP OFF"),
     ],
-    parse: |_, c, id, _| {
+    parse: Parse::One(|_, c, id, _| {
         let cam = c.uint("cam node number")?;
         let fol = c.uint("follower node number")?;
         let data = came(c, id)?;
         Ok((vec![cam, fol], ElementKind::Came(Box::new(data))))
-    },
+    }),
     write,
 };
 

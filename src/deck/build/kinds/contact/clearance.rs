@@ -2,7 +2,7 @@
 //! with radial clearance (grammar.md, "Elements").
 
 use super::super::v3;
-use super::super::{Card, row};
+use super::super::{Card, Parse, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use crate::model::{ClearanceData, ContactLaw};
@@ -31,7 +31,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "CLEARANCE LAW LN: least approach speed, m/s (> 0, default 1e-4)",
         ),
     ],
-    parse: |_, c, _, _| {
+    parse: Parse::One(|_, c, _, _| {
         let bearing = c.uint("bearing node number")?;
         let journal = c.uint("journal node number")?;
         let data = Builder::clearance(c)?;
@@ -39,7 +39,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             vec![bearing, journal],
             ElementKind::Clearance(Box::new(data)),
         ))
-    },
+    }),
     write,
 };
 

@@ -1,7 +1,7 @@
 //! `BUSHING <n1> <n2> K kx ky kz krx kry krz [C …] [AXES e1 e2]`: a six-component linear
 //! bushing in a frame fixed to its first node (issue 25 §3).
 
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use crate::model::BushingData;
@@ -17,7 +17,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
         ),
         row("AXES", "BUSHING: axes e1 e2 of its frame, global at t = 0"),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

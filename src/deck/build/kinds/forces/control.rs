@@ -2,7 +2,7 @@
 //! <X|Y|Z>) LAW <expression>`: a controlled input (issue 36). Their readers stay in
 //! `build/control.rs` beside the sensors and laws they share.
 
-use super::super::{Card, row};
+use super::super::{Card, Parse, row};
 use crate::model::ElementKind;
 use crate::model::control::{Actuator, ControlLaw};
 use std::fmt::Write;
@@ -31,13 +31,13 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "CONTROL: the input is a torque about the axis of the HINGE element that follows, N·m",
         ),
     ],
-    parse: |b, c, id, ty| {
+    parse: Parse::One(|b, c, id, ty| {
         if ty == "PID" {
             b.pid_card(c, id)
         } else {
             b.control_card(c, id)
         }
-    },
+    }),
     write: |_, e, s| {
         let ElementKind::Control(c) = &e.kind else {
             return;

@@ -1,7 +1,7 @@
 //! `RSPRING <hinge> [K k] [C c] [THETA0 θ0] [FRICTION Tf] [WREG ω]`: a rotational spring,
 //! damper and friction on a HINGE's angle (issue 25 §3).
 
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use crate::model::RSpringData;
@@ -22,7 +22,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "RSPRING: friction regularisation speed, rad/s (> 0, default 1e-3)",
         ),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

@@ -2,7 +2,7 @@
 //! along the line of its nodes (issue 25 §3; grammar.md, "Springs, bushings and
 //! rotational springs").
 
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use crate::model::{SpringData, SpringLength};
@@ -29,7 +29,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "SPRING: function number of a force-deflection curve F(deflection), N",
         ),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

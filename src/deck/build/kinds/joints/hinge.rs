@@ -2,7 +2,7 @@
 //! or sliding joint, its angle or travel optionally driven as a·f(t) (`build/drives.rs`).
 
 use super::super::v3;
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use std::fmt::Write;
@@ -18,7 +18,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "HINGE or PRISMATIC: the angle or travel prescribed as a·f(t) (function number)",
         ),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

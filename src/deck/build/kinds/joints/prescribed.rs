@@ -3,7 +3,7 @@
 //! beside the checks HINGE's `DRIVE` shares (a fixed or already driven freedom refused).
 
 use super::super::v3;
-use super::super::{Card, node_list, row};
+use super::super::{Card, Parse, node_list, row};
 use crate::model::{ElementKind, NodeMotion};
 use std::fmt::Write;
 
@@ -20,10 +20,10 @@ pub(in crate::deck::build) const CARD: Card = Card {
             "PRESCRIBED: the node's rotation about a fixed global axis",
         ),
     ],
-    parse: |b, c, _, _| {
+    parse: Parse::One(|b, c, _, _| {
         let (n, kind) = b.prescribed(c)?;
         Ok((vec![n], kind))
-    },
+    }),
     write: |_, e, s| {
         s.push_str(&node_list(e));
         let ElementKind::Prescribed { motion, drive } = &e.kind else {

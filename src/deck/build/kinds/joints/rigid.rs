@@ -1,6 +1,6 @@
 //! `RIGID <master> <n2> [<n3> …]`: a rigid body, every listed node moving with the first.
 
-use super::super::{Card, Parsed, node_list};
+use super::super::{Card, Parse, Parsed, node_list};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 
@@ -9,7 +9,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
     types: &["RIGID"],
     // Its row is the SECTIONS keyword's (deck/keywords.rs): one word, two uses.
     rows: &[],
-    parse,
+    parse: Parse::One(parse),
     write: |_, e, s| s.push_str(&node_list(e)),
 };
 

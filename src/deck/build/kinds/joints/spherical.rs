@@ -1,6 +1,6 @@
 //! `SPHERICAL` and `CLAMP <n1> <n2>`: relative translation blocked; everything blocked.
 
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 
@@ -11,7 +11,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
         row("SPHERICAL", "spherical joint"),
         row("CLAMP", "two nodes welded together"),
     ],
-    parse,
+    parse: Parse::One(parse),
     write: |_, e, s| s.push_str(&node_list(e)),
 };
 

@@ -2,7 +2,7 @@
 //! axes perpendicular at t = 0.
 
 use super::super::v3;
-use super::super::{Card, Parsed, node_list, row};
+use super::super::{Card, Parse, Parsed, node_list, row};
 use crate::deck::build::cursor::*;
 use crate::deck::build::*;
 use std::fmt::Write;
@@ -14,7 +14,7 @@ pub(in crate::deck::build) const CARD: Card = Card {
         row("UJOINT", "universal (Cardan) joint"),
         row("AXIS1", "UJOINT axis on the first node"),
     ],
-    parse,
+    parse: Parse::One(parse),
     write,
 };
 

@@ -229,9 +229,9 @@ impl BeamP {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::straight;
     use super::*;
     use crate::elements::Element;
-    use crate::elements::beam_p::tests::straight;
     use crate::elements::testing::*;
 
     /// A damped straight beam of order `p` (η = 1e-4 s: c_v η = 0.2, the damping part is a

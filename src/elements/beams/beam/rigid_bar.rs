@@ -1,7 +1,7 @@
 //! The rigid bar: a `BEAM` card whose section is `RIGID`.
 //!
 //! The bar keeps its shape: every node of the beam moves with its first node, by the
-//! constraint equations of the `RIGID` joint ([`super::joints`], `Φ = 0` for the relative
+//! constraint equations of the `RIGID` joint ([`crate::elements::joints`], `Φ = 0` for the relative
 //! position in the first node's frame and the relative rotation of each further node).
 //! Its inertia is the beam's with zero stiffness: consistent translational mass
 //! `∫ ρA Nᵢ Nⱼ ds` and rotary inertia `ρ diag(I₂+I₃, I₂, I₃)` lumped at the nodes
@@ -13,8 +13,8 @@
 //! (so a bar with `I₂ = I₃ = 0` has no inertia about its axis: a joint must hold that spin).
 //! Gravity: `∫ ρA Nᵢ ds g` on each node, exact for the same reason.
 
-use super::joints::{Joint, JointType};
-use super::{
+use crate::elements::joints::{Joint, JointType};
+use crate::elements::{
     BuildError, Element, ElementState, Energies, EvalContext, Local, NodeState, StateMismatch,
     StepLimit, beam_p,
 };

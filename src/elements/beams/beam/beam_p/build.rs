@@ -2,9 +2,9 @@
 //! card's order, with the nodes at the Gauss–Lobatto–Legendre points and the reference
 //! triads along the straight or curved (`ARC`) axis.
 
+use super::super::two_node::{Beam, BeamProperties, default_axis2, reference_triad};
 use super::BeamP;
 use crate::elements::Element;
-use crate::elements::beam::{Beam, BeamProperties, default_axis2, reference_triad};
 use crate::lagrange;
 use crate::model::arc::Arc;
 use crate::model::{ElementKind, Model};

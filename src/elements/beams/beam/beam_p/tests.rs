@@ -1,8 +1,8 @@
 //! The generic element checks for every order `p = 1…12`, and the order-p beam against the
 //! two-node beam and closed forms.
 
+use super::super::two_node::{Beam, default_axis2, reference_triad};
 use super::*;
-use crate::elements::beam::{Beam, default_axis2, reference_triad};
 use crate::elements::testing::*;
 use crate::rotation;
 

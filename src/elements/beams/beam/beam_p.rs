@@ -14,7 +14,7 @@
 //! (`K̃ = Λᵀ Λ_s` with the material tangent operator `T` of [`crate::rotation::tangent`]),
 //! `Γ⁰`, `K⁰` being the same expressions in the reference configuration — zero strain there
 //! for a straight or a curved reference axis alike (Jelenić & Crisfield 1999, §4).
-//! For `p = 1` this is exactly the two-node element of [`super::beam`].
+//! For `p = 1` this is exactly the two-node element of [`super::two_node`].
 //!
 //! A node may be more than π away from the reference node (a cantilever rolled into a full
 //! circle by one element puts its ends ±π from the middle): `ψᵢ` is the branch
@@ -55,9 +55,9 @@
 //! exact to degree `2p − 1`) — with its gyroscopic force `J Ω̇ + Ω × J Ω`, as the
 //! two-node beam. Gravity: `∫ ρA Nᵢ ds g` on node `i`.
 
-use super::beam::BeamProperties;
-use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
+use super::two_node::BeamProperties;
 use crate::dual::Real;
+use crate::elements::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::lagrange;
 use crate::model::ElementId;
 use crate::rotation::{self, c, skew};
@@ -592,9 +592,7 @@ mod tangent;
 pub use build::{from_model, with_properties};
 
 #[cfg(test)]
-#[path = "beam_p_tests.rs"]
 mod tests;
 
 #[cfg(test)]
-#[path = "beam_p_cases.rs"]
 mod cases;

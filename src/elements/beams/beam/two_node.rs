@@ -30,8 +30,8 @@
 //! (the same element, tested equal), which carries the Kelvin–Voigt damping stresses
 //! `η C (Γ̇, K̇)` (`beam_p/damping.rs`); this element is the undamped fast path.
 
-use super::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::dual::{Dual, Real};
+use crate::elements::{Element, Energies, EvalContext, Local, NodeState, rx, tx};
 use crate::model::ElementId;
 use crate::rotation::{self, c, skew};
 use nalgebra::{Matrix3, Vector3};
