@@ -35,8 +35,9 @@ pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// Version of the file format; a checkpoint of another version is refused. (2: the
 /// integrator's state names the time integration scheme that wrote it; 3: it holds the
 /// energy guard's record, and the step controller its regrowth after a landing, and the
-/// stage schemes' index-1 reaction solve's factors.)
-pub const FORMAT_VERSION: u32 = 3;
+/// stage schemes' index-1 reaction solve's factors; 4: the guard's record holds the largest
+/// energies of the oscillations, since its running minimum and over the run.)
+pub const FORMAT_VERSION: u32 = 4;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 

@@ -24,8 +24,9 @@ directory and prints its command line. Findings are copied to OUT/found/<class>/
              other than the output directory and the deck;
 - silent:    exit 0 on a deck the generator made invalid on purpose, a NaN or infinity in an
              output file, a summary that is not `complete`, or a run's energy balance error
-             above 0.1 with exit 0 (reported for review: the energy guard's bound is issue
-             35 §0's);
+             above 0.1 with exit 0 and no `coarse_balance` notice (the warning a run gives
+             when its balance closes that coarsely; the energy guard's bound is issue 35
+             §0's);
 - unlocated: exit 2 on a deck error with no `file:line:col` (the command line unchanged, so
              the deck is at fault).
 
@@ -522,7 +523,10 @@ def judge(case):
             scale = case.get("energy_scale") or 0.0
             # Judged only where the energies are physical (> 1 µJ): at round-off scale
             # (1e-20 J, a load on a fixed node) the relative balance is noise.
-            if isinstance(e, (int, float)) and e > 0.1 and scale > 1e-6:
+            # A run that says so (the `coarse_balance` notice of summary.json, printed as
+            # a warning) is not silent: it is a coarse step the user is told about.
+            warned = any(n.get("kind") == "coarse_balance" for n in s.get("notices") or [])
+            if isinstance(e, (int, float)) and e > 0.1 and scale > 1e-6 and not warned:
                 case["note"] = f"max_balance_error {e:.3g}, energy scale {scale:.3g} J"
                 found.append("silent")
     if rc == 2 and case["plain"]:

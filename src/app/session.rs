@@ -243,6 +243,19 @@ impl Session<'_> {
         // an interrupted run writes no row there.
         let exact = report.interrupted.is_none() && integ.exact_reactions();
         report.stats = integ.stats;
+        let error = self.writer.max_balance_error();
+        if report.failure.is_none()
+            && report.interrupted.is_none()
+            && error > solver::notice::COARSE_BALANCE
+        {
+            let coarse = solver::notice::Notice::CoarseBalance {
+                error,
+                created: integ.balance.largest_rise,
+                bound: integ.balance.its_bound,
+            };
+            eprintln!("warning: {coarse}");
+            integ.notices.push(coarse);
+        }
         notices_into(&mut self.writer, integ);
         if report.interrupted.is_some() {
             let signal = self.interrupts.signal_name().unwrap_or("a stop request");

@@ -176,7 +176,7 @@ impl Recorder {
             },
             report,
             self.balance.max_error(),
-            (integ.balance.largest_rise, integ.balance.its_bound),
+            integ.balance.summary(),
             report.and_then(|_| super::element_facts(integ)),
             &self.notes,
         )

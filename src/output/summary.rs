@@ -30,7 +30,7 @@ pub fn summary_value(
     head: &SummaryHead,
     report: Option<&RunReport>,
     max_balance: f64,
-    guard: (f64, f64),
+    guard: (f64, f64, f64),
     extra: Option<serde_json::Value>,
     notes: &serde_json::Map<String, serde_json::Value>,
 ) -> serde_json::Value {
@@ -69,6 +69,7 @@ pub fn summary_value(
             "max_balance_error": max_balance,
             "largest_created_j": guard.0,
             "its_bound_j": guard.1,
+            "largest_oscillation_j": guard.2,
         });
         v["failure"] = match &r.failure {
             Some(f) => failure_json(f),

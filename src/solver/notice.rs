@@ -54,7 +54,24 @@ pub enum Notice {
         /// The node whose velocity changed most.
         node: NodeId,
     },
+    /// A complete run whose energy balance closes coarsely: its largest error above
+    /// [`COARSE_BALANCE`] of the run's energy scale, within the bound of the energy guard
+    /// (`super::energy_guard`) — said at the end of the run.
+    CoarseBalance {
+        /// The largest balance error relative to the run's energy scale.
+        error: f64,
+        /// The largest energy created above the balance residual's running minimum, J.
+        created: f64,
+        /// The bound it was checked against, J.
+        bound: f64,
+    },
 }
+
+/// The balance error, relative to the run's energy scale, above which a complete run is
+/// said to close its energy balance coarsely ([`Notice::CoarseBalance`]): a tenth of the
+/// energy in play created or lost with no work to account for it is an error of the
+/// order of the motion's, not a detail of the scheme's.
+pub const COARSE_BALANCE: f64 = 0.1;
 
 impl std::fmt::Display for Notice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -94,6 +111,15 @@ impl std::fmt::Display for Notice {
                 f,
                 "the initial velocities were made consistent with the constraints and fixities (the smallest change in kinetic energy): by up to {change:.3e} m/s and {angular_change:.3e} rad/s (most at node {})",
                 node.0
+            ),
+            Notice::CoarseBalance {
+                error,
+                created,
+                bound,
+            } => write!(
+                f,
+                "the energy balance closes to {:.0} % of the run's energy scale (at most {created:.3e} J created above its running minimum, within the {bound:.3e} J the scheme's error allows: docs/stability.md, \"The energy guard's bound\"): the step resolves the motion, or the powers of the loads, drivers and dampers, coarsely, and the histories are those of this step, not converged ones; halve STEP (or ask ADAPTIVE) and compare",
+                100.0 * error
             ),
         }
     }

@@ -102,13 +102,16 @@ fn the_grazing_contact_at_20_73_s_is_crossed_without_an_energy_jump() {
 
 /// The fuzzer's energy cases (issue 35 §0, `tests/deck/energy/README.md`): each
 /// either completes without a burst or stops with the guard's diagnosis, its histories kept
-/// and marked incomplete. "Without a burst" is the guard's own bound, which is at most
-/// `(g + ROTATION_RESOLVED²) max E_osc` plus the accumulated quadrature and Newton
-/// allowances: `g` ≤ 0.222 for the schemes of these decks (HHT α = −0.1, the largest of the
-/// α family's `g`, `energy_guard::bound`), 0.25 from the rotation term's cap, so a
-/// complete run whose largest rise exceeds half of the largest `T + |U|` it wrote has let
-/// a burst through. Before the fix the five completed with rises of 4.1e4 … 1.5e17 J,
-/// as large as the energies they wrote (the bounds had grown with the bursts).
+/// and marked incomplete. "Without a burst" is the guard's ceiling, at most
+/// `(g + ROTATION_RESOLVED² + QUADRATURE_SHARE) max E_osc` plus this step's Newton term and
+/// the round-off: `g` ≤ 0.222 for the schemes of these decks (HHT α = −0.1, the largest of
+/// the α family's `g`, `energy_guard::bound`), ¼ from the rotation term's cap, 1/12 the
+/// trapezoid's over a run of steps; a complete run whose largest rise exceeds that share of
+/// the largest `T + |U|` it wrote has let a burst through. Before the fixes the first five
+/// completed with rises of 4.1e4 … 1.5e17 J, as large as the energies they wrote (the
+/// bounds had grown with the bursts), and the ten of 2026-11-28 with rises up to 1.2e6 J
+/// under bounds summed from brackets of 1e6 W powers or 1.5e5 steps' Newton terms. A
+/// complete run whose balance closes to worse than a tenth says so (`coarse_balance`).
 #[test]
 fn the_fuzzers_energy_cases_end_clean_or_stop() {
     let dir = common::root().join("tests/deck/energy");
@@ -118,7 +121,7 @@ fn the_fuzzers_energy_cases_end_clean_or_stop() {
         .filter(|p| p.extension().is_some_and(|e| e == "dat"))
         .collect();
     decks.sort();
-    assert_eq!(decks.len(), 7, "{decks:?}");
+    assert_eq!(decks.len(), 17, "{decks:?}");
     for deck in decks {
         let tmp = TempDir::new("energy_cases");
         let out = tmp.join("out");
@@ -136,17 +139,31 @@ fn the_fuzzers_energy_cases_end_clean_or_stop() {
         match o.status.code() {
             Some(0) => {
                 assert_eq!(s["complete"], true, "{name}: {s}");
+                // The guard's ceiling: g E_osc(s) (g ≤ 0.222 for the decks' schemes), the
+                // rotation's ¼ T and the trapezoid's 1/12 of the largest E_osc, each of the
+                // largest kinetic + |strain| energy at most (plus Newton's and round-off's
+                // terms, orders below).
+                let share = 0.222 + 0.25 + 1.0 / 12.0;
                 let created = s["energy"]["largest_created_j"].as_f64().unwrap();
-                let play = largest_oscillation(&out);
+                // The largest T + |U| of the run's steps (the rows of energy.csv may miss
+                // a driven pulse between them: 11_4398's 169 J fall between its rows).
+                let play = s["energy"]["largest_oscillation_j"].as_f64().unwrap();
+                assert!(play >= largest_oscillation(&out), "{name}: {s}");
                 assert!(
-                    created <= 0.5 * play,
+                    created <= share * play,
                     "{name}: {created:e} J created with at most {play:e} J in play"
                 );
                 // The same bound read by summary.json's figure, relative to the run's scale
                 // (11_2201 read 1.49 when each row's residual was made relative to the scale
                 // reached at that row: the round-off of a start from 1e-26 J).
                 let relative = s["energy"]["max_balance_error"].as_f64().unwrap();
-                assert!(relative <= 0.5, "{name}: max_balance_error {relative}");
+                assert!(relative <= share, "{name}: max_balance_error {relative}");
+                // A balance that closes to worse than a tenth is said (11_5355: 0.33).
+                let warned = stderr.contains("the energy balance closes to")
+                    && s["notices"]
+                        .as_array()
+                        .is_some_and(|n| n.iter().any(|n| n["kind"] == "coarse_balance"));
+                assert_eq!(warned, relative > 0.1, "{name}: {relative}: {stderr}");
             }
             Some(1) => {
                 assert_eq!(s["complete"], false, "{name}: {s}");

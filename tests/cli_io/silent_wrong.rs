@@ -124,18 +124,15 @@ fn the_energy_guard_refuses_energy_no_work_paid_for_and_passes_a_resolved_step()
     let m_old = energy_guard::measure(&integ.sys, &old, 0.0);
     let check = |nodes: &[mecano::elements::NodeState]| {
         let m_new = energy_guard::measure(&integ.sys, nodes, h);
-        energy_guard::check(
-            &energy_guard::Balance::default(),
-            &m_old,
-            &m_new,
-            (0.0, 0.0),
+        let step = energy_guard::Step {
+            old: m_old,
+            new: m_new,
+            drive: (0.0, 0.0),
             h,
-            h,
-            g,
-            floor,
-            0.0,
-            n,
-        )
+            t_new: h,
+            newton: 0.0,
+        };
+        energy_guard::check(&energy_guard::Balance::default(), &step, g, floor, n)
     };
     assert!(check(&new).is_ok());
     let mut fast = new.clone();

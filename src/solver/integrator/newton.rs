@@ -72,16 +72,19 @@ impl Integrator {
         };
         // The round-off of the equilibrium.
         let floor = self.residual_floor * self.sys.ref_length + straddle;
+        let step = energy_guard::Step {
+            old,
+            new,
+            drive: self.driver_powers(ctx),
+            h,
+            t_new: self.t + h,
+            newton,
+        };
         let passed = energy_guard::check(
             &self.balance,
-            &old,
-            &new,
-            self.driver_powers(ctx),
-            h,
-            self.t + h,
+            &step,
             self.guard_g,
             floor,
-            newton,
             self.sys.elements.len(),
         )?;
         // Kept for the next step if the accepted state is not changed (a restart of the
