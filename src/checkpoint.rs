@@ -36,8 +36,9 @@ pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// integrator's state names the time integration scheme that wrote it; 3: it holds the
 /// energy guard's record, and the step controller its regrowth after a landing, and the
 /// stage schemes' index-1 reaction solve's factors; 4: the guard's record holds the largest
-/// energies of the oscillations, since its running minimum and over the run.)
-pub const FORMAT_VERSION: u32 = 4;
+/// energies of the oscillations, since its running minimum and over the run; 5: and the
+/// energy created above its ceiling at the smallest step.)
+pub const FORMAT_VERSION: u32 = 5;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 

@@ -244,14 +244,18 @@ impl Session<'_> {
         let exact = report.interrupted.is_none() && integ.exact_reactions();
         report.stats = integ.stats;
         let error = self.writer.max_balance_error();
+        let b = integ.balance;
         if report.failure.is_none()
             && report.interrupted.is_none()
-            && error > solver::notice::COARSE_BALANCE
+            && (error > solver::notice::COARSE_BALANCE || b.unverified_steps > 0)
         {
             let coarse = solver::notice::Notice::CoarseBalance {
                 error,
-                created: integ.balance.largest_rise,
-                bound: integ.balance.its_bound,
+                created: b.largest_rise,
+                bound: b.its_bound,
+                unverified: b.unverified,
+                unverified_steps: b.unverified_steps,
+                first_unverified: b.first_unverified,
             };
             eprintln!("warning: {coarse}");
             integ.notices.push(coarse);

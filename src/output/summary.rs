@@ -3,6 +3,7 @@
 //! largest rise, the elements' facts), the same for the files (`super::Writer`) and for a
 //! run into memory (`super::Recorder`).
 
+use crate::solver::energy_guard::GuardSummary;
 use crate::solver::{Failure, Interruption, RunReport};
 
 /// What `summary.json` says of a run besides its report: the deck, its title, its
@@ -30,7 +31,7 @@ pub fn summary_value(
     head: &SummaryHead,
     report: Option<&RunReport>,
     max_balance: f64,
-    guard: (f64, f64, f64),
+    guard: GuardSummary,
     extra: Option<serde_json::Value>,
     notes: &serde_json::Map<String, serde_json::Value>,
 ) -> serde_json::Value {
@@ -67,9 +68,11 @@ pub fn summary_value(
         });
         v["energy"] = serde_json::json!({
             "max_balance_error": max_balance,
-            "largest_created_j": guard.0,
-            "its_bound_j": guard.1,
-            "largest_oscillation_j": guard.2,
+            "largest_created_j": guard.largest_created,
+            "its_bound_j": guard.its_bound,
+            "largest_oscillation_j": guard.largest_oscillation,
+            "unverified_j": guard.unverified,
+            "unverified_steps": guard.unverified_steps,
         });
         v["failure"] = match &r.failure {
             Some(f) => failure_json(f),

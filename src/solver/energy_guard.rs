@@ -46,11 +46,24 @@
 //!   own Newton term). A burst creates energy no source accounts for, however many steps
 //!   it spreads over, and it counts in the largest `E_osc`: a burst `B` from `E₀` in play
 //!   is refused once `B > (g + ¼) E₀ + (E₀ + B)/12`.
+//! - **At the smallest step.** A rise above the ceiling but within the summed bound is
+//!   refused and the step retried shorter, down to `MINSTEP`: a step that resolves the
+//!   powers brings it under the ceiling. One that cannot — a mode the step cannot follow
+//!   at any length the deck allows, such as a PID's derivative gain on a hub of almost no
+//!   inertia from rest (`tests/deck/fuzz/pid_flexible_arm_dense_eigen_hang.dat`: a time
+//!   constant of 5e-8 s against a smallest step of 1e-6 s: the trapezoid of `u θ̇` counts
+//!   0.026 J created over its first 50 steps, where the HHT scheme's own work
+//!   `f_{n+1+α}·Δq` shows 4.1e-3 J dissipated by the run's end) — is
+//!   accepted at the smallest step: what it created above the ceiling is added to the
+//!   run's *unverified* energy ([`Balance::unverified`]), the run of steps checked starts
+//!   afresh, and the run ends with a warning (`Notice::CoarseBalance`). Above the summed
+//!   bound a step is refused at any length.
 //! - `floor`: the round-off of the equilibrium (`Integrator::residual_floor` over the
 //!   model's size) and of the energies' sums (`64 ε n_elements E_play`).
 //!
 //! A step that fails it is refused and retried shorter (its modes back under `ωh ≤ π`,
-//! where the bound holds); at the smallest step the run stops with the diagnosis. A
+//! where the bound holds); at the smallest step the run stops with the diagnosis (above
+//! the summed bound) or goes on and says so (above the ceiling only). A
 //! spurious Newton root (1e5 J from 179 J, issue 28) fails it by orders of magnitude; so
 //! does the burst of issue 35 (66 J created in 2 ms on the seed's scene); a run the steps
 //! resolve never comes near it (`tests/stability.rs`).
@@ -138,6 +151,13 @@ pub struct Balance {
     pub osc_max: f64,
     /// The largest `E_osc` of the run's accepted steps, J.
     pub largest_osc: f64,
+    /// What steps at the smallest step created above the ceiling, within the summed
+    /// bound, summed over the run, J (module docs, "At the smallest step").
+    pub unverified: f64,
+    /// How many such steps were accepted.
+    pub unverified_steps: u64,
+    /// When the first of them ended, s.
+    pub first_unverified: f64,
 }
 
 /// A converged step, as the guard checks it.
@@ -155,6 +175,9 @@ pub struct Step {
     pub t_new: f64,
     /// What Newton left of it (module docs), J.
     pub newton: f64,
+    /// Whether it is as short as a step may be cut (`MINSTEP`): the ceiling is then no
+    /// longer a reason to refuse it (module docs, "At the smallest step").
+    pub at_floor: bool,
 }
 
 /// A step the guard passed: the record to keep if the step is accepted.
@@ -198,6 +221,7 @@ pub fn check(
         h,
         t_new,
         newton,
+        at_floor,
     } = *step;
     let (old, new) = (&old, &new);
     let mut b = *record;
@@ -224,8 +248,16 @@ pub fn check(
     // The ceiling (module docs): the scheme's and the rotation's terms, the trapezoid's
     // share of the largest energy of the oscillations since `s`, this step's Newton term.
     let osc_max = b.osc_max.max(b.osc).max(old.osc).max(new.osc);
-    let ceiling = g * b.osc + rotation + QUADRATURE_SHARE * osc_max + newton;
-    let bound = (g * b.osc + quadrature + rotation).min(ceiling) + floor;
+    let ceiling = g * b.osc + rotation + QUADRATURE_SHARE * osc_max + newton + floor;
+    let summed = g * b.osc + quadrature + rotation + floor;
+    // Above the ceiling but within the summed bound, a step is refused and retried shorter
+    // until it is as short as it may be; there it is accepted, and said (module docs).
+    let over_ceiling = rise > ceiling && rise <= summed;
+    let bound = if over_ceiling && at_floor {
+        summed
+    } else {
+        summed.min(ceiling)
+    };
     // Dampers cannot take more than the energy in play and the work of the step: a
     // trapezoidal dissipation beyond that is the quadrature of a power the step does not
     // resolve (the fuzzer's case 11:3199: 34.9 J "dissipated" in one step of a 0.58 J
@@ -250,7 +282,21 @@ pub fn check(
     }
     b.residual = residual;
     b.largest_osc = b.largest_osc.max(old.osc).max(new.osc);
-    if residual < b.min {
+    if rise > b.largest_rise {
+        b.largest_rise = rise;
+        b.its_bound = bound;
+    }
+    if over_ceiling {
+        // Accepted at the smallest step: what it created above the ceiling is counted
+        // and said, and the run of steps checked starts afresh here, so that the next
+        // steps are not cut again for what this one could not resolve.
+        if b.unverified_steps == 0 {
+            b.first_unverified = t_new;
+        }
+        b.unverified += rise - ceiling;
+        b.unverified_steps += 1;
+    }
+    if residual < b.min || over_ceiling {
         b.min = residual;
         b.t_min = t_new;
         b.osc = new.osc;
@@ -261,20 +307,36 @@ pub fn check(
         b.quadrature = quadrature;
         b.rotation = rotation;
         b.osc_max = osc_max;
-        if rise > b.largest_rise {
-            b.largest_rise = rise;
-            b.its_bound = bound;
-        }
     }
     Ok(Passed(b))
 }
 
 impl Balance {
-    /// What `summary.json` says of the guard: the largest rise accepted, its bound and the
-    /// largest `E_osc` of the run, J.
-    pub fn summary(&self) -> (f64, f64, f64) {
-        (self.largest_rise, self.its_bound, self.largest_osc)
+    /// What `summary.json` says of the guard (its `energy` object's entries).
+    pub fn summary(&self) -> GuardSummary {
+        GuardSummary {
+            largest_created: self.largest_rise,
+            its_bound: self.its_bound,
+            largest_oscillation: self.largest_osc,
+            unverified: self.unverified,
+            unverified_steps: self.unverified_steps,
+        }
     }
+}
+
+/// What `summary.json` says of the energy guard, J.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GuardSummary {
+    /// The largest rise of the balance residual accepted.
+    pub largest_created: f64,
+    /// The bound it was checked against.
+    pub its_bound: f64,
+    /// The largest `E_osc = T + |U|` of the run's steps.
+    pub largest_oscillation: f64,
+    /// Energy created above the ceiling by steps accepted at the smallest step.
+    pub unverified: f64,
+    /// How many such steps.
+    pub unverified_steps: u64,
 }
 
 impl Passed {
@@ -414,5 +476,40 @@ mod tests {
             }
         }
         panic!("20 J created in a 10 J system with no work was accepted");
+    }
+
+    /// "At the smallest step": a rise above the ceiling but within the summed bound is
+    /// refused at any step the stepper may still cut, accepted at `MINSTEP`, counted as
+    /// unverified, and the run of steps checked starts afresh after it; above the summed
+    /// bound a step is refused at the smallest step too.
+    #[test]
+    fn the_ceiling_cuts_steps_down_to_the_smallest_then_says_so() {
+        let g = 0.1;
+        let rec = Balance::default();
+        // 10 J in play, 2.5 J created, the powers' brackets allow 2e3 J: above the
+        // ceiling, g E_osc(s) + E_osc,max / 12 = 1 J + 12.5 J / 12 = 2.04 J.
+        let mut s = step(m(10.0, 0.0), m(12.5, 0.0), 1e-3, 1e-3);
+        s.drive = (1e6, -1e6);
+        let j = check(&rec, &s, g, 0.0, 1).expect_err("above the ceiling, not at the floor");
+        let ceiling = 0.1 * 10.0 + 12.5 / 12.0;
+        assert!((j.bound - ceiling).abs() < 1e-12, "{j:?}");
+        s.at_floor = true;
+        let rec = check(&rec, &s, g, 0.0, 1)
+            .expect("within the summed bound at the smallest step")
+            .record();
+        assert_eq!(rec.unverified_steps, 1);
+        assert!((rec.unverified - (2.5 - ceiling)).abs() < 1e-12, "{rec:?}");
+        assert!((rec.first_unverified - 1e-3).abs() < 1e-15);
+        // The run of steps checked starts afresh: a next step that creates nothing passes
+        // at the stepper's full length.
+        let next = step(m(12.5, 0.0), m(12.5, 0.0), 1e-3, 2e-3);
+        let rec = check(&rec, &next, g, 0.0, 1)
+            .expect("nothing created")
+            .record();
+        assert_eq!(rec.unverified_steps, 1);
+        // Above the summed bound (no brackets: g E_osc + 1/12 only), refused at the floor.
+        let mut burst = step(m(12.5, 0.0), m(40.0, 0.0), 1e-3, 3e-3);
+        burst.at_floor = true;
+        assert!(check(&rec, &burst, g, 0.0, 1).is_err());
     }
 }

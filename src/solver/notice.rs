@@ -64,6 +64,13 @@ pub enum Notice {
         created: f64,
         /// The bound it was checked against, J.
         bound: f64,
+        /// Energy created above the guard's ceiling by steps accepted at the smallest
+        /// step, J (`energy_guard::Balance::unverified`; 0 if none).
+        unverified: f64,
+        /// How many such steps.
+        unverified_steps: u64,
+        /// When the first of them ended, s.
+        first_unverified: f64,
     },
 }
 
@@ -116,11 +123,28 @@ impl std::fmt::Display for Notice {
                 error,
                 created,
                 bound,
-            } => write!(
-                f,
-                "the energy balance closes to {:.0} % of the run's energy scale (at most {created:.3e} J created above its running minimum, within the {bound:.3e} J the scheme's error allows: docs/stability.md, \"The energy guard's bound\"): the step resolves the motion, or the powers of the loads, drivers and dampers, coarsely, and the histories are those of this step, not converged ones; halve STEP (or ask ADAPTIVE) and compare",
-                100.0 * error
-            ),
+                unverified,
+                unverified_steps,
+                first_unverified,
+            } => {
+                if *unverified_steps > 0 {
+                    write!(
+                        f,
+                        "{unverified_steps} steps at the smallest step (MINSTEP), the first ending at t = {first_unverified:.6e} s, created {unverified:.3e} J above the share of the energy in play that the scheme's error explains (the energy guard's ceiling: docs/stability.md, \"The energy guard's bound\"); they were kept because no step the deck allows resolves the powers there. "
+                    )?;
+                }
+                if *error <= COARSE_BALANCE {
+                    return write!(
+                        f,
+                        "the run's energy balance closes to {error:.1e} of its energy scale"
+                    );
+                }
+                write!(
+                    f,
+                    "the energy balance closes to {:.0} % of the run's energy scale (at most {created:.3e} J created above its running minimum, within the {bound:.3e} J the scheme's error allows: docs/stability.md, \"The energy guard's bound\"): the step resolves the motion, or the powers of the loads, drivers and dampers, coarsely, and the histories are those of this step, not converged ones; halve STEP (or ask ADAPTIVE) and compare",
+                    100.0 * error
+                )
+            }
         }
     }
 }

@@ -131,6 +131,8 @@ fn the_energy_guard_refuses_energy_no_work_paid_for_and_passes_a_resolved_step()
             h,
             t_new: h,
             newton: 0.0,
+            // At the smallest step: a jump is refused even where no shorter step is left.
+            at_floor: true,
         };
         energy_guard::check(&energy_guard::Balance::default(), &step, g, floor, n)
     };

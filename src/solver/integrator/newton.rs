@@ -79,6 +79,7 @@ impl Integrator {
             h,
             t_new: self.t + h,
             newton,
+            at_floor: h <= self.event_floor * (1.0 + crate::solver::FLOOR_SLACK),
         };
         let passed = energy_guard::check(
             &self.balance,
