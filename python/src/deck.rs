@@ -64,6 +64,11 @@ impl Deck {
         let mut model = py
             .detach(|| mdeck::parse_deck_with(&text, &name, &set))
             .map_err(|e| deck_error(py, e))?;
+        // A deck read from a file names its superelements' FILES relative to its own
+        // directory, as the command line's `load_deck` reads them.
+        if let Some(dir) = path.as_deref().and_then(std::path::Path::parent) {
+            model.resolve_superelement_dirs(dir);
+        }
         if refine > 1 {
             model
                 .refine(refine)
