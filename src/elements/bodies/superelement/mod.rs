@@ -19,6 +19,7 @@ pub mod invariants;
 pub mod kernel;
 pub mod mtx;
 pub mod reduce;
+pub mod spin;
 #[cfg(test)]
 mod tests;
 
@@ -45,6 +46,8 @@ pub struct Superelement {
     body: Body,
     /// The modal nodes' reference positions (the coordinates are `x − x_ref`).
     q_ref: Vec<Vector3<f64>>,
+    /// Its rotation against its lowest elastic frequency (`spin`).
+    spin: spin::SpinWatch,
 }
 
 impl Superelement {
@@ -103,6 +106,7 @@ impl Superelement {
             id,
             nodes,
             lay: Layout { nb, nm },
+            spin: spin::SpinWatch::new(&body),
             body,
             q_ref,
         })
@@ -116,6 +120,7 @@ impl Superelement {
             id,
             nodes,
             lay: Layout { nb, nm },
+            spin: spin::SpinWatch::new(&body),
             body,
             q_ref,
         }
@@ -432,6 +437,13 @@ impl Element for Superelement {
         let lever = b.c0.norm() / b.mass.max(1e-300);
         let w2 = st.w.norm_squared() * lever;
         b.mass * (st.a0.norm() + gravity.norm() + st.wd.norm() * lever + w2) + kq.amax()
+    }
+
+    fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {
+        let what = format!("element {} (SUPERELEMENT)", self.id.0);
+        if let Some(msg) = self.spin.check(&what, ctx.t, &nodes[self.nodes[0]].w) {
+            eprintln!("warning: {msg}");
+        }
     }
 
     fn summary(&self) -> Option<serde_json::Value> {
