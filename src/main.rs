@@ -112,6 +112,7 @@ restart is refused: no valid checkpoint, a complete run, or a deck whose text di
 }
 
 fn main() -> ExitCode {
+    mecano::interrupt::Interrupts::default_dispositions();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

@@ -274,3 +274,50 @@ fn a_deck_path_that_is_not_a_file_or_a_pipe_is_refused() {
         }
     }
 }
+
+/// A phase that polls no flag (the dense eigen-solver's QR of `--check`'s step-resolution
+/// table: ~10 s on this deck) ends at once on SIGINT, also when the process was started
+/// with SIGINT ignored, as a script's background job is (`main` gives SIGINT and SIGTERM
+/// their default action back). Before, it ran to its end through the signal (the fuzzer's
+/// case 17:6222, 15 s).
+#[test]
+fn check_ends_on_sigint_even_when_started_with_it_ignored() {
+    use std::os::unix::process::CommandExt;
+    let deck = common::root().join("tests/data/slow_check/deck.dat");
+    let mut c = bin();
+    c.arg("--check").arg(&deck);
+    // SAFETY: `signal` with `SIG_IGN` in the forked child before exec: async-signal-safe.
+    unsafe {
+        c.pre_exec(|| {
+            libc::signal(libc::SIGINT, libc::SIG_IGN);
+            Ok(())
+        });
+    }
+    let mut child = c
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("starts");
+    // Into the deck's reading and the model's checks, before the QR's end.
+    std::thread::sleep(Duration::from_millis(300));
+    let t0 = Instant::now();
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGINT);
+    }
+    let limit = Duration::from_secs(5);
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            use std::os::unix::process::ExitStatusExt;
+            // Ended by the signal itself (the QR alone takes seconds: it cannot have
+            // finished first).
+            assert_eq!(status.signal(), Some(libc::SIGINT), "{status:?}");
+            break;
+        }
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            panic!("--check sat through SIGINT for {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
