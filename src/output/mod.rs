@@ -378,18 +378,16 @@ impl Writer {
         crate::safe_file::write_atomic(&tmp, &self.dir.join("summary.json"), text.as_bytes())
     }
 
-    /// Writes the final state if it was skipped by `EVERY` (not for an interrupted run:
-    /// its files end where a restart goes on), flushes, and rewrites `summary.json` with
-    /// the counters and the `complete` flag.
-    pub fn finish(
+    /// Writes the final state if `EVERY` skipped it (not for an interrupted run: its files
+    /// end where a restart goes on); once only, so that the application can read the
+    /// balance of the whole run (`max_balance_error`) before [`Writer::finish`].
+    pub fn write_last(
         &mut self,
         integ: &crate::solver::Integrator,
         report: &RunReport,
     ) -> io::Result<()> {
         // (No state was accepted when the initial one could not be computed: no row.)
-        // Whatever happens to that row or the flush, the summary is written: every
-        // failure leaves its record (issue 28).
-        let last = if self.last_row.is_some()
+        if self.last_row.is_some()
             && self.last_row != Some(integ.stats.steps)
             && report.interrupted.is_none()
         {
@@ -400,7 +398,20 @@ impl Writer {
             })
         } else {
             Ok(())
-        };
+        }
+    }
+
+    /// Writes the final state if it was skipped by `EVERY` (not for an interrupted run:
+    /// its files end where a restart goes on), flushes, and rewrites `summary.json` with
+    /// the counters and the `complete` flag.
+    pub fn finish(
+        &mut self,
+        integ: &crate::solver::Integrator,
+        report: &RunReport,
+    ) -> io::Result<()> {
+        // Whatever happens to that row or the flush, the summary is written: every
+        // failure leaves its record (issue 28).
+        let last = self.write_last(integ, report);
         let flushed = self.flush();
         self.guard = integ.balance.summary();
         let extra = element_facts(integ);

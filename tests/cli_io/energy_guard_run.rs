@@ -124,7 +124,7 @@ fn the_fuzzers_energy_cases_end_clean_or_stop() {
         .filter(|p| p.extension().is_some_and(|e| e == "dat"))
         .collect();
     decks.sort();
-    assert_eq!(decks.len(), 17, "{decks:?}");
+    assert_eq!(decks.len(), 18, "{decks:?}");
     for deck in decks {
         let tmp = TempDir::new("energy_cases");
         let out = tmp.join("out");
