@@ -115,3 +115,113 @@ fn plate_pendulum_conserves_energy_and_follows_the_rigid_plate() {
     );
     assert!(dist <= bound && dist > time_err, "{dist} against {bound}");
 }
+
+/// Bad interfaces over many FE nodes: located errors (the token for what the deck alone
+/// shows wrong, the card for what needs the mesh), exit 2, nothing written.
+#[test]
+fn bad_interfaces_are_refused_located() {
+    let dir = common::TempDir::new("se_bad_rbe");
+    let src = common::root().join("decks/superelement");
+    let card = "RBE2 1000 SET 1 TO 11 RBE3 2000 SET 65 66 76 77";
+    let cases: [(&str, &str, &str); 9] = [
+        (
+            "missing",
+            "RBE2 1000 SET 1 TO 11 999 RBE3 2000 SET 65 66 76 77",
+            "line 18:3: element 2: SUPERELEMENT: RBE2 1000: FE node 999 is not in nodes.csv",
+        ),
+        (
+            "empty",
+            "RBE2 1000 SET 1 TO 11 RBE3 2000 WITHIN 0.01",
+            "RBE3 2000: the set is empty",
+        ),
+        (
+            "collinear",
+            "RBE2 1000 SET 1 TO 11 RBE3 2000 SET 56 TO 66",
+            "RBE3 2000: its 11 FE nodes are collinear",
+        ),
+        (
+            "overlap",
+            "RBE2 1000 SET 1 TO 11 RBE3 2000 SET 10 11 21 22",
+            "RBE3 2000: FE node 10 is also in the set of interface node 1000",
+        ),
+        (
+            "taken",
+            "RBE2 1000 SET 1 TO 11 RBE3 2000 SET 65 66 76 77",
+            "RBE2 12: FE node 12 is a node of the mesh",
+        ),
+        (
+            "not_interface",
+            "RBE2 1000 SET 1 TO 11 RBE3 3000 SET 65 66 76 77",
+            "d.dat:18:94",
+        ),
+        (
+            "empty_set",
+            "RBE2 1000 SET RBE3 2000 SET 65 66 76 77",
+            "at least one FE node",
+        ),
+        (
+            "weights_count",
+            "RBE2 1000 SET 1 TO 11 RBE3 2000 SET 65 66 76 77 WEIGHTS 1 2 3",
+            "4 weights",
+        ),
+        (
+            "weights_rigid",
+            "RBE2 1000 SET 1 TO 11 WEIGHTS 1 RBE3 2000 SET 65 66 76 77",
+            "WEIGHTS only after an RBE3",
+        ),
+    ];
+    for (name, clause, expect) in cases {
+        let case = dir.join(name);
+        std::fs::create_dir_all(case.join("plate")).expect("dir");
+        for f in ["K.mtx", "M.mtx", "nodes.csv", "dofs.csv"] {
+            std::fs::copy(src.join("plate").join(f), case.join("plate").join(f)).expect("copy");
+        }
+        let mut deck = std::fs::read_to_string(src.join("plate_pendulum.dat")).expect("deck");
+        assert!(deck.contains(card));
+        deck = deck.replacen(card, clause, 1);
+        if name == "taken" {
+            deck = deck
+                .replace("INTERFACE 1000 1", "INTERFACE 12 1")
+                .replace("RBE2 1000", "RBE2 12");
+        }
+        std::fs::write(case.join("d.dat"), deck).expect("write");
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+            .arg(case.join("d.dat"))
+            .args(["-q", "-o"])
+            .arg(case.join("out"))
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(expect), "{name}: `{expect}` not in: {err}");
+        // Build errors at the card, parse errors at their token.
+        let located = err.contains("d.dat: line 18:3") || err.contains("d.dat:18:");
+        assert!(located, "{name}: {err}");
+        assert!(
+            !case.join("out").exists(),
+            "{name}: wrote its output directory"
+        );
+    }
+}
+
+/// `WITHIN` and `WEIGHTS` read, print back and read again to the same model (the deck of
+/// `decks/` round-trips with `SET … TO …` in tests/deck/deck_roundtrip.rs).
+#[test]
+fn within_and_weights_round_trip() {
+    let path = common::deck_path("superelement/plate_pendulum.dat");
+    let text = std::fs::read_to_string(&path).expect("deck");
+    // The four corner nodes are within 0.036 m of their centroid, the next ones 0.056 away.
+    let within = text.replace("RBE3 2000 SET 65 66 76 77", "RBE3 2000 WITHIN 0.036");
+    let weighted = text.replace(
+        "RBE3 2000 SET 65 66 76 77",
+        "RBE3 2000 SET 65 66 76 77 WEIGHTS 1 1 1 1",
+    );
+    for t in [&within, &weighted] {
+        let mut m = mecano::deck::parse_deck(t, "d.dat").expect("parses");
+        let back = mecano::deck::write_deck(&m);
+        let mut again = mecano::deck::parse_deck(&back, "d.dat").expect("reads back");
+        mecano::deck::strip_spans(&mut m);
+        mecano::deck::strip_spans(&mut again);
+        assert_eq!(m, again, "{back}");
+    }
+}

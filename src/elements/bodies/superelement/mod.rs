@@ -19,11 +19,11 @@ pub mod invariants;
 pub mod kernel;
 pub mod mtx;
 pub mod rbe;
+#[cfg(test)]
+mod rbe_tests;
 pub mod reduce;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod rbe_tests;
 
 use crate::dual::Dual;
 use crate::elements::registry::{Kind, not_mine};
@@ -73,7 +73,8 @@ impl Superelement {
         let tr = match rbes.is_empty() {
             true => None,
             false => Some(
-                rbe::Transform::new(&fe, &rbes, &d.interface).map_err(|e| invalid(e.to_string()))?,
+                rbe::Transform::new(&fe, &rbes, &d.interface)
+                    .map_err(|e| invalid(e.to_string()))?,
             ),
         };
         let fe = rbe::with_nodes(fe, &rbes);

@@ -75,7 +75,9 @@ pub enum RbeError {
         missing: u32,
     },
     /// The interface node's number is a node of the mesh.
-    #[error("{kind} {node}: FE node {node} is a node of the mesh; give the interface node a number nodes.csv does not use")]
+    #[error(
+        "{kind} {node}: FE node {node} is a node of the mesh; give the interface node a number nodes.csv does not use"
+    )]
     Taken {
         /// RBE2 / RBE3.
         kind: &'static str,
@@ -417,13 +419,8 @@ pub fn reduce(
         nodes: fe.nodes.clone(),
         dofs: tr.dofs.clone(),
     };
-    let mut red = super::reduce::reduce(
-        &fe_t,
-        &tr.congruent(k),
-        &tr.congruent(m),
-        interface,
-        modes,
-    )?;
+    let mut red =
+        super::reduce::reduce(&fe_t, &tr.congruent(k), &tr.congruent(m), interface, modes)?;
     red.basis = tr.expand(&red.basis);
     Ok(red)
 }

@@ -19,10 +19,8 @@ fn merge(beams: &[FeModel]) -> FeModel {
     let mut off = 0;
     for (b, fe) in beams.iter().enumerate() {
         let nb = fe.dofs.len();
-        k.view_mut((off, off), (nb, nb))
-            .copy_from(&fe.k.to_dense());
-        m.view_mut((off, off), (nb, nb))
-            .copy_from(&fe.m.to_dense());
+        k.view_mut((off, off), (nb, nb)).copy_from(&fe.k.to_dense());
+        m.view_mut((off, off), (nb, nb)).copy_from(&fe.m.to_dense());
         let shift = 100 * (b as u32 + 1);
         nodes.extend(fe.nodes.iter().map(|(p, x)| (p + shift, *x)));
         dofs.extend(fe.dofs.iter().map(|(p, c)| (p + shift, *c)));
@@ -237,8 +235,8 @@ fn averaging_interface_adds_no_stiffness() {
     let fe_g = rbe::with_nodes(fe.clone(), std::slice::from_ref(&r));
     let body = Body::new(&fe_g, &m, &red, 100, &[]).expect("mass");
     let (mm, kk) = body.free_free();
-    let cb = lowest_eigenvalues(&kk, &mm, &(0..mm.nrows()).collect::<Vec<_>>(), 12)
-        .expect("reduced");
+    let cb =
+        lowest_eigenvalues(&kk, &mm, &(0..mm.nrows()).collect::<Vec<_>>(), 12).expect("reduced");
     let mut worst = 0.0f64;
     for (a, b) in cb.iter().zip(&full) {
         worst = worst.max((a - b).abs() / bound(*b));
@@ -290,6 +288,12 @@ fn bad_sets_are_refused() {
     assert!(matches!(taken, Err(RbeError::Taken { node: 3, .. })));
     let empty = rbe::resolve_set(&fe, RbeKind::Average, 100, &at, &SetSpec::Within(0.5));
     assert!(matches!(empty, Err(RbeError::Empty { .. })));
-    let near = rbe::resolve_set(&fe, RbeKind::Average, 100, &Vector3::x(), &SetSpec::Within(0.26));
+    let near = rbe::resolve_set(
+        &fe,
+        RbeKind::Average,
+        100,
+        &Vector3::x(),
+        &SetSpec::Within(0.26),
+    );
     assert_eq!(near.expect("three nodes"), vec![4, 5, 6]);
 }
