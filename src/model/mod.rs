@@ -34,7 +34,7 @@ pub use scheme::{Scheme, SchemeNameError};
 pub use section::{BeamProperties, Geometry, Section, SectionData};
 pub use springs::{BushingData, RSpringData, SpringData, SpringLength};
 pub use summary::{Effects, Generated, Summary};
-pub use superelement::SuperelementData;
+pub use superelement::{RbeKind, RbeSpec, SetSpec, SuperelementData};
 
 use indexmap::IndexMap;
 use nalgebra::{Matrix3, Vector3};

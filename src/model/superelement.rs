@@ -19,6 +19,40 @@ pub struct SuperelementData {
     /// The generated modal nodes: their translations carry the elastic coordinates (6 per
     /// non-frame interface node, then the modal amplitudes), three per node.
     pub modal: Vec<NodeId>,
+    /// Interfaces over many FE nodes (`RBE2`, `RBE3`), in the deck's order; each `node` is
+    /// one of `interface`'s FE numbers.
+    pub rbe: Vec<RbeSpec>,
+}
+
+/// Which interface over many FE nodes (`crate::elements::bodies::superelement::rbe`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RbeKind {
+    /// `RBE2`: the set follows the interface node rigidly.
+    Rigid,
+    /// `RBE3`: the interface node follows the set's weighted least-squares rigid fit.
+    Average,
+}
+
+/// The FE nodes an `RBE2`/`RBE3` joins.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SetSpec {
+    /// `SET`: FE node numbers.
+    Nodes(Vec<u32>),
+    /// `WITHIN r`: every FE node within `r` (m) of the interface node.
+    Within(f64),
+}
+
+/// An `RBE2`/`RBE3` clause of a `SUPERELEMENT`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RbeSpec {
+    /// Rigid or averaging.
+    pub kind: RbeKind,
+    /// The interface node's FE number (named in `INTERFACE`, not a node of the mesh).
+    pub node: u32,
+    /// Its FE nodes.
+    pub set: SetSpec,
+    /// `RBE3 … WEIGHTS`: one per set node (empty: all 1).
+    pub weights: Vec<f64>,
 }
 
 impl SuperelementData {

@@ -18,6 +18,9 @@ pub mod fe;
 pub mod invariants;
 pub mod kernel;
 pub mod mtx;
+pub mod rbe;
+#[cfg(test)]
+mod rbe_tests;
 pub mod reduce;
 pub mod spin;
 #[cfg(test)]
@@ -64,6 +67,20 @@ impl Superelement {
             message: format!("SUPERELEMENT: {message}"),
         };
         let fe = fe::read(&d.dir).map_err(|e| invalid(e.to_string()))?;
+        // Interfaces over many FE nodes: their nodes at their deck nodes' places.
+        let at = |a: u32| {
+            let i = d.interface.iter().position(|&b| b == a).unwrap_or(0);
+            model.nodes[nodes[i]].position
+        };
+        let rbes = rbe::resolve_all(&fe, &d.rbe, at).map_err(|e| invalid(e.to_string()))?;
+        let tr = match rbes.is_empty() {
+            true => None,
+            false => Some(
+                rbe::Transform::new(&fe, &rbes, &d.interface)
+                    .map_err(|e| invalid(e.to_string()))?,
+            ),
+        };
+        let fe = rbe::with_nodes(fe, &rbes);
         for &a in &d.interface {
             if !fe.nodes.contains_key(&a) {
                 return Err(invalid(format!(
@@ -93,7 +110,7 @@ impl Superelement {
             }
         }
         let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
-        let red = reduce::reduce(&fe, &k, &m, &d.interface, d.modes as usize)
+        let red = rbe::reduce(&fe, &k, &m, tr.as_ref(), &d.interface, d.modes as usize)
             .map_err(|e| invalid(e.to_string()))?;
         let body = Body::new(&fe, &m, &red, d.interface[0], &d.interface[1..])
             .map_err(|e| invalid(e.to_string()))?;

@@ -13,13 +13,13 @@ use crate::rotation;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// Section of the test frame: E, G, A, Iy, Iz, J, ρ.
-const E: f64 = 2.1e11;
-const G: f64 = 8.0e10;
-const A: f64 = 1e-4;
-const IY: f64 = 8.3e-10;
-const IZ: f64 = 2.1e-9;
-const J: f64 = 2.5e-9;
-const RHO: f64 = 7800.0;
+pub(super) const E: f64 = 2.1e11;
+pub(super) const G: f64 = 8.0e10;
+pub(super) const A: f64 = 1e-4;
+pub(super) const IY: f64 = 8.3e-10;
+pub(super) const IZ: f64 = 2.1e-9;
+pub(super) const J: f64 = 2.5e-9;
+pub(super) const RHO: f64 = 7800.0;
 
 /// A 3D frame: the polyline through `corners`, each segment in `per` elements; FE nodes
 /// numbered 1, 2, … along it.
