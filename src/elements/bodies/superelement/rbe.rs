@@ -364,7 +364,7 @@ pub fn average_basis(fe: &FeModel, r: &Rbe) -> Result<(DMatrix<f64>, DMatrix<f64
     }
     let ev = SymmetricEigen::new(j).eigenvalues;
     let (lo, hi) = (ev.min(), ev.max());
-    if k < 3 || !(hi > 0.0) || lo <= COLLINEAR_RATIO * hi {
+    if k < 3 || hi.is_nan() || hi <= 0.0 || lo <= COLLINEAR_RATIO * hi {
         return Err(RbeError::Collinear {
             node: r.node,
             count: k,
