@@ -434,7 +434,9 @@ fn iterate(
         }
         // Restart on the best Ritz vectors when the next block would not fit.
         if m_all + pending.len() > max_dim {
-            if let Some((sigma, floor)) = probe {
+            // (With fewer Ritz values than modes asked for there is no count-th one to
+            // bound with: the fuzzer's case 19:16501 indexed past them and panicked.)
+            if let Some((sigma, floor)) = probe.filter(|_| m_all >= count) {
                 // The count-th Ritz value bounds the count-th mode: θ_c(Ritz) ≤ θ_c, so
                 // ω²_c ≤ 1/θ_c(Ritz) + σ (Cauchy interlacing). When the wanted modes lie
                 // far below |σ|, their θ crowd at 1/|σ| and separate slowly: shift to
