@@ -25,8 +25,8 @@ const fn kw(name: &'static str, section: &'static str, doc: &'static str) -> Key
 pub static KEYWORDS: LazyLock<Vec<KeywordDoc>> =
     LazyLock::new(|| ROWS.iter().copied().chain(super::build::rows()).collect());
 
-/// The keywords of the sections, of the shared element fields and of the kinds not yet in
-/// the registry.
+/// The keywords of the sections and of the fields several element kinds share (each kind's
+/// own are its `CARD`'s rows).
 const ROWS: &[KeywordDoc] = &[
     // sections
     kw(

@@ -457,8 +457,9 @@ impl Element for Superelement {
     }
 
     fn commit(&mut self, ctx: &EvalContext, nodes: &[NodeState], _lambda: &[f64]) {
-        let what = format!("element {} (SUPERELEMENT)", self.id.0);
-        if let Some(msg) = self.spin.check(&what, ctx.t, &nodes[self.nodes[0]].w) {
+        let id = self.id.0;
+        let what = || format!("element {id} (SUPERELEMENT)");
+        if let Some(msg) = self.spin.check(what, ctx.t, &nodes[self.nodes[0]].w) {
             eprintln!("warning: {msg}");
         }
     }

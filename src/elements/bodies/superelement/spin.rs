@@ -53,8 +53,15 @@ impl SpinWatch {
         }
     }
 
-    /// The warning to give at an accepted state whose frame turns at `w` (rad/s), once.
-    pub fn check(&mut self, what: &str, t: f64, w: &Vector3<f64>) -> Option<String> {
+    /// The warning to give at an accepted state whose frame turns at `w` (rad/s), once;
+    /// `what` names the element (called only then: nothing is formatted at the other
+    /// steps).
+    pub fn check(
+        &mut self,
+        what: impl FnOnce() -> String,
+        t: f64,
+        w: &Vector3<f64>,
+    ) -> Option<String> {
         let share = w.norm_squared() / self.omega1_2;
         // (A NaN rate is not a reason to warn: the guard stops such a run.)
         if self.warned || share.is_nan() || share <= SPIN_SHARE {
@@ -62,7 +69,8 @@ impl SpinWatch {
         }
         self.warned = true;
         Some(format!(
-            "t = {t:.6e} s: {what} turns at |Ω| = {:.4e} rad/s, (Ω/ω₁)² = {share:.3} of its lowest elastic frequency with its frame held, ω₁ = {:.4e} rad/s: a floating frame's linear body has no centrifugal stiffening, so its deflections err by about that share, and above ω₁ its modes grow without bound (docs/superelements.md, \"What it leaves out\")",
+            "t = {t:.6e} s: {} turns at |Ω| = {:.4e} rad/s, (Ω/ω₁)² = {share:.3} of its lowest elastic frequency with its frame held, ω₁ = {:.4e} rad/s: a floating frame's linear body has no centrifugal stiffening, so its deflections err by about that share, and above ω₁ its modes grow without bound (docs/superelements.md, \"What it leaves out\")",
+            what(),
             w.norm(),
             self.omega1_2.sqrt()
         ))
