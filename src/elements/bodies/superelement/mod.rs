@@ -23,6 +23,8 @@ pub mod rbe;
 mod rbe_tests;
 pub mod reduce;
 pub mod sparse;
+#[cfg(test)]
+mod sparse_tests;
 pub mod spin;
 #[cfg(test)]
 mod tests;
