@@ -15,6 +15,7 @@
 //! `∂r/∂q`, one for `c_v ∂r/∂v + c_a ∂r/∂a`.
 
 pub mod fe;
+pub mod frame_model;
 pub mod invariants;
 pub mod kernel;
 pub mod mtx;

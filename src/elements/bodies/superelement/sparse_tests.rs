@@ -3,9 +3,9 @@
 //! fixed-interface frequencies and modes (up to sign), reduced stiffness and inertia
 //! invariants, each to a tolerance derived from what the two routes compute differently.
 
+use super::frame_model::l_frame;
 use super::reduce::{DENSE_UP_TO, reduce, reduce_body};
 use super::sparse;
-use super::tests::l_frame;
 use crate::lanczos;
 use nalgebra::{DMatrix, SymmetricEigen};
 
