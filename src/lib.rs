@@ -19,6 +19,7 @@ pub mod interrupt;
 pub mod interval;
 mod kinds;
 pub mod lagrange;
+pub mod lanczos;
 pub mod model;
 pub mod modes;
 pub mod output;

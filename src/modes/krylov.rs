@@ -6,93 +6,7 @@
 
 use crate::solver::linear::{LinearError, SparseSystem};
 
-/// A vector whose norm (in the basis's inner product: `M` for the symmetric path, a scaled
-/// Euclidean one for the first-order path) falls below this fraction of its norm before
-/// projection is linearly dependent on the basis (after two Gram–Schmidt passes,
-/// round-off leaves ~ε).
-pub(super) const DROP: f64 = 1e-10;
-
-/// `aᵀb` with eight partial sums (a sequential sum does not vectorise: the
-/// orthogonalisation, bound by these products, ran at a quarter of the speed).
-pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for ((s, x), y) in acc.iter_mut().zip(x).zip(y) {
-            *s += x * y;
-        }
-    }
-    acc.iter().sum::<f64>() + tail
-}
-
-/// `y += a x`.
-pub(super) fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
-    y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
-}
-
-/// An `M`-orthonormal basis with the mass images of its vectors.
-#[derive(Default)]
-pub(super) struct Basis {
-    pub(super) q: Vec<Vec<f64>>,
-    pub(super) mq: Vec<Vec<f64>>,
-}
-
-impl Basis {
-    /// Projects `w` on the basis twice (Gram–Schmidt), returning the summed coefficients;
-    /// `mw`, when given, is `M w` and is kept so (`M q` is stored: no product).
-    pub(super) fn project(&self, w: &mut [f64], mut mw: Option<&mut [f64]>) -> Vec<f64> {
-        let mut coef = vec![0.0; self.q.len()];
-        for _ in 0..2 {
-            for (i, (q, mq)) in self.q.iter().zip(&self.mq).enumerate() {
-                let c = dot(mq, w);
-                axpy(w, -c, q);
-                if let Some(mw) = mw.as_deref_mut() {
-                    axpy(mw, -c, mq);
-                }
-                coef[i] += c;
-            }
-        }
-        coef
-    }
-
-    /// `M`-orthonormalises `ws` (each with its mass image `M w`) against the basis and
-    /// each other, appending those that are independent; returns how many were appended.
-    pub(super) fn extend(&mut self, ws: Vec<(Vec<f64>, Vec<f64>)>) -> usize {
-        let mut added = 0;
-        for (mut w, mut mw) in ws {
-            let n0 = dot(&mw, &w).max(0.0).sqrt();
-            self.project(&mut w, Some(&mut mw));
-            let n1 = dot(&mw, &w).max(0.0).sqrt();
-            if n1 <= DROP * n0 || n1 == 0.0 {
-                continue;
-            }
-            w.iter_mut().for_each(|v| *v /= n1);
-            self.mq.push(mw.into_iter().map(|v| v / n1).collect());
-            self.q.push(w);
-            added += 1;
-        }
-        added
-    }
-
-    /// `Σ_j s_j q_j` over the basis.
-    pub(super) fn combine(vs: &[Vec<f64>], s: impl Iterator<Item = f64>, n: usize) -> Vec<f64> {
-        let mut y = vec![0.0; n];
-        for (v, sj) in vs.iter().zip(s) {
-            if sj != 0.0 {
-                axpy(&mut y, sj, v);
-            }
-        }
-        y
-    }
-}
+pub(super) use crate::lanczos::{DROP, axpy, dot};
 
 /// `y = A x` over the pattern of `mat` with values `a`, rows and columns below `rows`,
 /// `cols` (`y` has `rows` entries).
@@ -158,6 +72,23 @@ pub enum SparseError {
         /// Solves spent.
         solves: usize,
     },
+}
+
+impl From<crate::lanczos::LanczosError> for SparseError {
+    fn from(e: crate::lanczos::LanczosError) -> Self {
+        match e {
+            crate::lanczos::LanczosError::Massless => SparseError::Massless,
+            crate::lanczos::LanczosError::NoConvergence {
+                converged,
+                count,
+                solves,
+            } => SparseError::NoConvergence {
+                converged,
+                count,
+                solves,
+            },
+        }
+    }
 }
 
 impl From<LinearError> for SparseError {

@@ -50,22 +50,14 @@
 //! by that solver.
 
 pub use super::krylov::SparseError;
-use super::krylov::{Basis, dot};
+use super::krylov::dot;
 use super::linearise::{self, ElementMatrices};
 use crate::elements::NodeState;
+pub use crate::lanczos::{BLOCK, ShiftInvert, TOL};
+use crate::lanczos::{CLUSTER, Outcome, iterate};
 use crate::solver::system::System;
-use nalgebra::{DMatrix, SymmetricEigen};
-use rand::{Rng, SeedableRng};
+use nalgebra::DMatrix;
 
-/// Block size: a free body's six rigid motions (a cluster that fills the block doubles it).
-pub const BLOCK: usize = 6;
-/// Relative residual `‖T φ − θ φ‖_M ≤ TOL |θ|` of a converged Ritz pair. The eigenvalue's
-/// error is below the residual's square over the gap (symmetric problem), below the residual
-/// itself inside a cluster: 1e-9 keeps frequencies to ~1e-9 even for exact pairs, and the
-/// Rayleigh quotient of the shape makes it smaller still.
-pub const TOL: f64 = 1e-9;
-/// Relative spread under which converged values are one cluster (a multiple eigenvalue).
-const CLUSTER: f64 = 1e-6;
 /// The smallest shift is `SHIFT_FLOOR · ε ω²_max`: the round-off of the assembled `K`
 /// (`ε ω²_max`, [`super::dense::ZERO_FACTOR`]) must not make `K − σM` singular.
 const SHIFT_FLOOR: f64 = 1e3;
@@ -134,12 +126,6 @@ impl Operator<'_> {
         y
     }
 
-    /// `T v`: the nodal part of `A(σ)⁻¹ [M v; 0]`.
-    fn apply(&mut self, v: &[f64]) -> Result<Vec<f64>, SparseError> {
-        let mv = self.mass(v);
-        self.apply_mass(&mv)
-    }
-
     /// `T v` from `M v`.
     fn apply_mass(&mut self, mv: &[f64]) -> Result<Vec<f64>, SparseError> {
         let mut rhs = vec![0.0; self.sys.n_eq()];
@@ -148,6 +134,25 @@ impl Operator<'_> {
         self.solves += 1;
         rhs.truncate(self.nn);
         Ok(rhs)
+    }
+}
+
+impl ShiftInvert for Operator<'_> {
+    type Error = SparseError;
+    fn dim(&self) -> usize {
+        self.nn
+    }
+    fn free(&self) -> usize {
+        self.nn - (self.sys.n_eq() - self.nn)
+    }
+    fn mass(&self, x: &[f64]) -> Vec<f64> {
+        Operator::mass(self, x)
+    }
+    fn apply_mass(&mut self, mv: &[f64]) -> Result<Vec<f64>, SparseError> {
+        Operator::apply_mass(self, mv)
+    }
+    fn solves(&self) -> usize {
+        self.solves
     }
 }
 
@@ -324,152 +329,6 @@ pub fn lowest(
             Ok(out)
         }
         Err(e) => Err(e),
-    }
-}
-
-/// What [`iterate`] ends with.
-enum Outcome {
-    /// The `count` Ritz values of largest `|θ|` and their vectors (`M`-orthonormal).
-    Converged(Vec<f64>, Vec<Vec<f64>>),
-    /// Asked to probe: the basis filled once without convergence, and the wanted modes
-    /// lie far below the shift; the better shift.
-    Probe(f64),
-}
-
-/// Block Lanczos (module docs) until the `count` Ritz values of largest `|θ|` converge,
-/// or, with `probe = Some((σ, floor))`, until the basis first fills if the wanted modes
-/// then lie far below the shift `σ` (more than 10 times closer to 0).
-fn iterate(
-    op: &mut Operator,
-    count: usize,
-    block: usize,
-    probe: Option<(f64, f64)>,
-) -> Result<Outcome, SparseError> {
-    let nn = op.nn;
-    let free = nn - (op.sys.n_eq() - nn);
-    let max_dim = (3 * count).max(count + 3 * block).max(30).min(free);
-    let budget = op.solves + 40 * count + 400;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(24);
-    type Pairs = Vec<(Vec<f64>, Vec<f64>)>;
-    let mut random_block = |op: &mut Operator, b: usize| -> Result<Pairs, SparseError> {
-        (0..b)
-            .map(|_| {
-                let r: Vec<f64> = (0..nn).map(|_| rng.random::<f64>() - 0.5).collect();
-                let w = op.apply(&r)?;
-                let mw = op.mass(&w);
-                Ok((w, mw))
-            })
-            .collect()
-    };
-    let mut q = Basis::default();
-    let start = random_block(op, block)?;
-    q.extend(start);
-    if q.q.is_empty() {
-        return Err(SparseError::Massless);
-    }
-    // H on the expanded vectors (the first `h.nrows()` of the basis).
-    let mut h = DMatrix::<f64>::zeros(0, 0);
-    loop {
-        let m_all = q.q.len();
-        let m_old = h.nrows();
-        let pending: Vec<usize> = (m_old..m_all).collect();
-        let mut ws = Vec::with_capacity(pending.len());
-        let mut hn = DMatrix::<f64>::zeros(m_all, m_all);
-        hn.view_mut((0, 0), (m_old, m_old)).copy_from(&h);
-        for &j in &pending {
-            let mut w = op.apply_mass(&q.mq[j].clone())?;
-            let coef = q.project(&mut w, None);
-            for (i, cf) in coef.into_iter().enumerate() {
-                hn[(i, j)] = cf;
-                if i < m_old {
-                    hn[(j, i)] = cf;
-                }
-            }
-            ws.push(w);
-        }
-        let h_sym = (&hn + hn.transpose()) * 0.5;
-        h = h_sym.clone();
-        // Gram matrix of the remainders, for the residuals (their mass images serve the
-        // next extension too).
-        let mws: Vec<Vec<f64>> = ws.iter().map(|w| op.mass(w)).collect();
-        let g = DMatrix::from_fn(ws.len(), ws.len(), |a, b| dot(&mws[a], &ws[b]));
-        let eig = SymmetricEigen::new(h_sym);
-        let mut order: Vec<usize> = (0..m_all).collect();
-        order.sort_by(|&a, &b| {
-            eig.eigenvalues[b]
-                .abs()
-                .total_cmp(&eig.eigenvalues[a].abs())
-        });
-        let wanted = count.min(m_all);
-        let converged = order[..wanted]
-            .iter()
-            .filter(|&&i| {
-                let s = eig.eigenvectors.column(i);
-                let sp = DMatrix::from_fn(pending.len(), 1, |a, _| s[pending[a]]);
-                let r2 = (sp.transpose() * &g * &sp)[(0, 0)].max(0.0);
-                r2.sqrt() <= TOL * eig.eigenvalues[i].abs()
-            })
-            .count();
-        let ritz = |idx: &[usize]| -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
-            idx.iter()
-                .map(|&i| {
-                    let s = eig.eigenvectors.column(i);
-                    (
-                        Basis::combine(&q.q, s.iter().copied(), nn),
-                        Basis::combine(&q.mq, s.iter().copied(), nn),
-                    )
-                })
-                .unzip()
-        };
-        if converged == count {
-            let theta = order[..count].iter().map(|&i| eig.eigenvalues[i]).collect();
-            return Ok(Outcome::Converged(theta, ritz(&order[..count]).0));
-        }
-        if op.solves >= budget || m_all >= free {
-            return Err(SparseError::NoConvergence {
-                converged,
-                count,
-                solves: op.solves,
-            });
-        }
-        // Restart on the best Ritz vectors when the next block would not fit.
-        if m_all + pending.len() > max_dim {
-            // (With fewer Ritz values than modes asked for there is no count-th one to
-            // bound with: the fuzzer's case 19:16501 indexed past them and panicked.)
-            if let Some((sigma, floor)) = probe.filter(|_| m_all >= count) {
-                // The count-th Ritz value bounds the count-th mode: θ_c(Ritz) ≤ θ_c, so
-                // ω²_c ≤ 1/θ_c(Ritz) + σ (Cauchy interlacing). When the wanted modes lie
-                // far below |σ|, their θ crowd at 1/|σ| and separate slowly: shift to
-                // half that bound, kept above the round-off of K (`floor`).
-                let bound = 1.0 / eig.eigenvalues[order[count - 1]] + sigma;
-                let target = -(0.5 * bound).max(floor);
-                if target > 0.1 * sigma {
-                    return Ok(Outcome::Probe(target));
-                }
-            }
-            let keep: Vec<usize> = order[..(count + block).min(m_all)].to_vec();
-            let (vq, vmq) = ritz(&keep);
-            q = Basis { q: vq, mq: vmq };
-            h = DMatrix::from_fn(keep.len(), keep.len(), |a, b| {
-                if a == b {
-                    eig.eigenvalues[keep[a]]
-                } else {
-                    0.0
-                }
-            });
-        }
-        let added = q.extend(ws.into_iter().zip(mws).collect());
-        if added == 0 {
-            // An invariant subspace: continue from fresh random vectors.
-            let fresh = random_block(op, block)?;
-            if q.extend(fresh) == 0 {
-                return Err(SparseError::NoConvergence {
-                    converged,
-                    count,
-                    solves: op.solves,
-                });
-            }
-        }
     }
 }
 

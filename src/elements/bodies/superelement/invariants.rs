@@ -63,12 +63,30 @@ pub struct Body {
 )]
 pub struct MassNotPositive;
 
+/// A mass matrix as the invariants use it: its products `M X` with tall dense blocks.
+pub trait MassProduct {
+    /// `M X`.
+    fn times(&self, x: &DMatrix<f64>) -> DMatrix<f64>;
+}
+
+impl MassProduct for DMatrix<f64> {
+    fn times(&self, x: &DMatrix<f64>) -> DMatrix<f64> {
+        self * x
+    }
+}
+
+impl MassProduct for super::mtx::SymMatrix {
+    fn times(&self, x: &DMatrix<f64>) -> DMatrix<f64> {
+        super::sparse::sym_mul_dense(self, x)
+    }
+}
+
 impl Body {
-    /// The invariants of `fe` (dense mass `m`) for the basis `red` about the frame node
+    /// The invariants of `fe` (mass `m`, dense or the reader's sparse one) for the basis `red` about the frame node
     /// `frame_node` with the other interface nodes `iface`.
     pub fn new(
         fe: &FeModel,
-        m: &DMatrix<f64>,
+        m: &impl MassProduct,
         red: &Reduction,
         frame_node: u32,
         iface: &[u32],
@@ -96,9 +114,19 @@ impl Body {
         a0.view_mut((0, 6), (nfe, n)).copy_from(&red.basis);
         // A₁ = [A₁₁ … A₁ₙ]: column 3k + j is e_j × Φ_k on translational rows.
         let mut a1 = DMatrix::zeros(nfe, 3 * n);
+        // Each node's translational rows, found once (a search per node and mode is
+        // quadratic in the mesh).
+        let mut trans: indexmap::IndexMap<u32, [Option<usize>; 3]> =
+            fe.nodes.keys().map(|&p| (p, [None; 3])).collect();
+        for (r, &(p, c)) in fe.dofs.iter().enumerate() {
+            if c < 3
+                && let Some(t) = trans.get_mut(&p)
+            {
+                t[c as usize] = Some(r);
+            }
+        }
         for k in 0..n {
-            for p in fe.nodes.keys() {
-                let rows: Vec<Option<usize>> = (0..3).map(|c| fe.dof_of(*p, c)).collect();
+            for rows in trans.values() {
                 let u = Vector3::from_fn(|c, _| rows[c].map_or(0.0, |r| red.basis[(r, k)]));
                 if u == Vector3::zeros() {
                     continue;
@@ -113,8 +141,8 @@ impl Body {
                 }
             }
         }
-        let ma0 = m * &a0;
-        let ma1 = m * &a1;
+        let ma0 = m.times(&a0);
+        let ma1 = m.times(&a1);
         let sym = |x: DMatrix<f64>| (&x + x.transpose()) * 0.5;
         let m0 = sym(a0.transpose() * &ma0);
         Cholesky::new(m0.clone()).ok_or(MassNotPositive)?;

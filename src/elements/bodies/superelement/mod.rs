@@ -15,6 +15,7 @@
 //! `∂r/∂q`, one for `c_v ∂r/∂v + c_a ∂r/∂a`.
 
 pub mod fe;
+pub mod frame_model;
 pub mod invariants;
 pub mod kernel;
 pub mod mtx;
@@ -22,6 +23,9 @@ pub mod rbe;
 #[cfg(test)]
 mod rbe_tests;
 pub mod reduce;
+pub mod sparse;
+#[cfg(test)]
+mod sparse_tests;
 pub mod spin;
 #[cfg(test)]
 mod tests;
@@ -109,11 +113,25 @@ impl Superelement {
                 )));
             }
         }
-        let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
-        let red = rbe::reduce(&fe, &k, &m, tr.as_ref(), &d.interface, d.modes as usize)
-            .map_err(|e| invalid(e.to_string()))?;
-        let body = Body::new(&fe, &m, &red, d.interface[0], &d.interface[1..])
-            .map_err(|e| invalid(e.to_string()))?;
+        let body = match tr.as_ref() {
+            // Interfaces over many nodes: the dense route on TᵀKT, TᵀMT.
+            Some(_) if fe.dofs.len() > reduce::DENSE_MAX_DOFS => Err(format!(
+                "RBE2/RBE3 interfaces are reduced densely, up to {} FE dofs; this model has {}",
+                reduce::DENSE_MAX_DOFS,
+                fe.dofs.len()
+            )),
+            Some(tr) => {
+                let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
+                rbe::reduce(&fe, &k, &m, Some(tr), &d.interface, d.modes as usize)
+                    .map_err(|e| e.to_string())
+                    .and_then(|red| {
+                        Body::new(&fe, &m, &red, d.interface[0], &d.interface[1..])
+                            .map_err(|e| e.to_string())
+                    })
+            }
+            None => reduce::reduce_body(&fe, &d.interface, d.modes as usize),
+        }
+        .map_err(invalid)?;
         let nm = d.modal.len();
         let q_ref = nodes[1 + nb..]
             .iter()

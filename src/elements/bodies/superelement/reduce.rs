@@ -21,7 +21,31 @@
 //! positive definite (the interface holds the body) but only `M_II` semi-definite.
 
 use super::fe::FeModel;
+use super::invariants::Body;
 use nalgebra::{Cholesky, DMatrix, Dyn, SymmetricEigen};
+
+/// Up to this many FE dofs a model is reduced densely (the dense path is the reference
+/// the sparse one is tested against, and avoids the Lanczos for models where asking for
+/// most interior modes is common); above, sparsely ([`super::sparse`]).
+pub const DENSE_UP_TO: usize = 600;
+
+/// The reduction and its inertia invariants, on the dense path up to [`DENSE_UP_TO`] FE
+/// dofs (or when the modes asked leave fewer than a Lanczos block of interior modes
+/// beyond them), on the sparse path above.
+pub fn reduce_body(fe: &FeModel, interface: &[u32], modes: usize) -> Result<Body, String> {
+    let n = fe.dofs.len();
+    let interior = n.saturating_sub(6 * interface.len());
+    let dense = n <= DENSE_UP_TO || modes + crate::lanczos::BLOCK > interior;
+    let (frame, iface) = (interface[0], &interface[1..]);
+    if dense && n <= DENSE_MAX_DOFS {
+        let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
+        let red = reduce(fe, &k, &m, interface, modes).map_err(|e| e.to_string())?;
+        Body::new(fe, &m, &red, frame, iface).map_err(|e| e.to_string())
+    } else {
+        let red = super::sparse::reduce(fe, interface, modes).map_err(|e| e.to_string())?;
+        Body::new(fe, &fe.m, &red, frame, iface).map_err(|e| e.to_string())
+    }
+}
 
 /// Above this many FE dofs the dense reduction is refused (`O(n³)` flops, `n²` memory).
 pub const DENSE_MAX_DOFS: usize = 4000;
@@ -100,6 +124,21 @@ pub enum ReduceError {
         /// Above.
         above: usize,
     },
+    /// The sparse factorisation or the eigen-solver failed otherwise.
+    #[error("sparse reduction: {0}")]
+    Sparse(String),
+    /// The shift-invert Lanczos did not converge.
+    #[error(
+        "the fixed-interface modes did not converge: {converged} of {count} after {solves} solves (shift-invert Lanczos)"
+    )]
+    NoConvergence {
+        /// Converged.
+        converged: usize,
+        /// Asked for (the kept modes and a block beyond, for the multiplicity check).
+        count: usize,
+        /// Solves spent.
+        solves: usize,
+    },
     /// Too large for the dense reduction.
     #[error(
         "{0} degrees of freedom: the dense reduction of this version takes at most {DENSE_MAX_DOFS}"
@@ -124,19 +163,21 @@ fn sub(a: &DMatrix<f64>, rows: &[usize], cols: &[usize]) -> DMatrix<f64> {
     DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])])
 }
 
-/// The Craig–Bampton reduction of `fe` (dense `k`, `m`) about `interface` (FE nodes; the
-/// first is the frame node) with `modes` fixed-interface modes.
-pub fn reduce(
-    fe: &FeModel,
-    k: &DMatrix<f64>,
-    m: &DMatrix<f64>,
-    interface: &[u32],
-    modes: usize,
-) -> Result<Reduction, ReduceError> {
+/// The FE rows split for the reduction: the frame node's, the other interface nodes', the
+/// interior (ascending).
+pub struct Partition {
+    /// The frame node's six rows.
+    pub frame: [usize; 6],
+    /// The other interface nodes' rows, six per node.
+    pub boundary: Vec<usize>,
+    /// The interior rows, ascending.
+    pub interior: Vec<usize>,
+}
+
+/// Splits `fe`'s rows about `interface` (the first the frame node), checking the interface
+/// and that `modes` interior modes exist.
+pub fn partition(fe: &FeModel, interface: &[u32], modes: usize) -> Result<Partition, ReduceError> {
     let n = fe.dofs.len();
-    if n > DENSE_MAX_DOFS {
-        return Err(ReduceError::TooLarge(n));
-    }
     for (i, a) in interface.iter().enumerate() {
         if interface[..i].contains(a) {
             return Err(ReduceError::Repeated(*a));
@@ -156,6 +197,31 @@ pub fn reduce(
             interior: interior.len(),
         });
     }
+    Ok(Partition {
+        frame,
+        boundary,
+        interior,
+    })
+}
+
+/// The Craig–Bampton reduction of `fe` (dense `k`, `m`) about `interface` (FE nodes; the
+/// first is the frame node) with `modes` fixed-interface modes.
+pub fn reduce(
+    fe: &FeModel,
+    k: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+    interface: &[u32],
+    modes: usize,
+) -> Result<Reduction, ReduceError> {
+    let n = fe.dofs.len();
+    if n > DENSE_MAX_DOFS {
+        return Err(ReduceError::TooLarge(n));
+    }
+    let Partition {
+        frame,
+        boundary,
+        interior,
+    } = partition(fe, interface, modes)?;
     let nb = boundary.len();
     let mut basis = DMatrix::zeros(n, nb + modes);
     for (j, &r) in boundary.iter().enumerate() {
@@ -214,7 +280,7 @@ pub fn reduce(
 const MULTIPLE_TOL: f64 = 1e-9;
 
 /// Refuses a count of modes that ends inside a multiple eigenvalue (`mu` descending).
-fn check_whole(mu: &[f64], modes: usize) -> Result<(), ReduceError> {
+pub(super) fn check_whole(mu: &[f64], modes: usize) -> Result<(), ReduceError> {
     if modes == 0 || modes >= mu.len() {
         return Ok(());
     }
