@@ -124,6 +124,88 @@ fn modes_of_the_superelement_are_the_beams() {
     }
 }
 
+/// `modes` and `--check` list a superelement's own (fixed-interface) modes: for the bar
+/// clamped at its frame node with 9 modes kept, they are the clamped bar's 8 lowest modes
+/// computed on the beams (an independent route: the assembled beams' eigen-solve against
+/// the reduction's interior one) to the listing's 7 printed digits (1e-6), and `--check` states each one's samples per
+/// period at the deck's step, `1/(f h)`, to its 4 printed digits.
+#[test]
+fn a_superelements_own_modes_are_listed_with_the_steps_resolution() {
+    let dir = common::TempDir::new("se_own_modes");
+    let beams_dir = dir.join("b");
+    let o = bin()
+        .arg("modes")
+        .arg(common::deck_path("superelement/cantilever_beams.dat"))
+        .args(["-q", "--count", "8", "-o"])
+        .arg(&beams_dir)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let beams: Vec<f64> = std::fs::read_to_string(beams_dir.join("modes.csv"))
+        .expect("modes.csv")
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .nth(2)
+                .expect("column")
+                .parse()
+                .expect("number")
+        })
+        .collect();
+    // The listing: "element 1: 9 fixed-interface modes …", then one row per mode.
+    let listed = |stdout: &str| -> Vec<Vec<f64>> {
+        let mut lines = stdout
+            .lines()
+            .skip_while(|l| !l.contains("fixed-interface modes of its own"));
+        assert!(lines.next().is_some(), "no listing in:\n{stdout}");
+        lines
+            .map_while(|l| {
+                let cells: Vec<f64> = l
+                    .split_whitespace()
+                    .filter_map(|c| c.parse().ok())
+                    .collect();
+                (l.starts_with("  ") && cells.len() >= 2).then_some(cells)
+            })
+            .collect()
+    };
+    let o = bin()
+        .arg("modes")
+        .arg(common::deck_path("superelement/cantilever_se.dat"))
+        .args(["--count", "8", "--set", "modes=9", "-o"])
+        .arg(dir.join("s"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = listed(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!(rows.len(), 9);
+    for (i, b) in beams.iter().enumerate() {
+        let e = (rows[i][1] - b).abs() / b;
+        assert!(
+            e < 1e-6,
+            "own mode {}: {} Hz vs the beams' {b} Hz",
+            i + 1,
+            rows[i][1]
+        );
+    }
+    // --check on the pendulum (h = 1e-3 s, 4 modes): samples per period 1/(f h).
+    let o = bin()
+        .arg("--check")
+        .arg(common::deck_path("superelement/pendulum_se.dat"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = listed(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!(rows.len(), 4);
+    for r in &rows {
+        let (f, samples) = (r[1], r[2]);
+        assert!(
+            (samples * f * 1e-3 - 1.0).abs() < 1e-3,
+            "{f} Hz: {samples} samples per period at h = 1e-3 s"
+        );
+    }
+}
+
 /// Runs `deck` with the overrides into memory; node `node`'s positions.
 fn positions(deck: &str, set: &[(String, f64)], node: u32) -> (Vec<f64>, Vec<[f64; 3]>) {
     let model = load_deck_with(&common::deck_path(deck), set).expect("deck");

@@ -354,6 +354,14 @@ pub trait Element: Send + Sync {
         None
     }
 
+    /// The frequencies (Hz, ascending) of the modes the element carries as its own
+    /// coordinates — a reduced body's kept fixed-interface modes — which `--check` and
+    /// `modes` list with what the deck's step resolves of them. `None` for an element
+    /// without such modes.
+    fn own_modes_hz(&self) -> Option<Vec<f64>> {
+        None
+    }
+
     /// Time derivatives `[∂Φ_k/∂t, ∂²Φ_k/∂t²]` of the element's `k`-th constraint
     /// (unscaled) at time `t`: zero for a scleronomic joint (the default), `[−a ḟ, −a f̈]`
     /// for a driver's `g(q) − a f(t)` ([`drive::TimeLaw`]). The integrator's start imposes

@@ -482,13 +482,19 @@ impl Element for Superelement {
         }
     }
 
+    fn own_modes_hz(&self) -> Option<Vec<f64>> {
+        Some(
+            self.body
+                .omega2
+                .iter()
+                .map(|w2| w2.sqrt() / (2.0 * std::f64::consts::PI))
+                .collect(),
+        )
+    }
+
     fn summary(&self) -> Option<serde_json::Value> {
         let b = &self.body;
-        let hz: Vec<f64> = b
-            .omega2
-            .iter()
-            .map(|w2| w2.sqrt() / (2.0 * std::f64::consts::PI))
-            .collect();
+        let hz = self.own_modes_hz().unwrap_or_default();
         Some(serde_json::json!({
             "mass_kg": b.mass,
             "elastic_coordinates": b.n,
