@@ -615,3 +615,69 @@ fn a_superelement_spun_past_its_first_frequency_is_said() {
         assert_eq!(strain > 1e-6 * energy, warned, "Ω = {omega}: {strain} J");
     }
 }
+
+/// The deformed FE mesh for ParaView (`OUTPUT … VTK`): the pendulum as a superelement of
+/// all 42 modes, its FE nodes recovered from the frame and the elastic coordinates at the
+/// end (0.4 s). The interface tip's recovered place is the model's node 2 (the interface
+/// constraint, solved to Newton's tolerance), and the bar's interior FE nodes 3–9 lie on
+/// the beams deck's nodes 3–9 within the largest distance of the two decks' tip paths (the
+/// same two discretisations; the tip, farthest from the hinge, moves most).
+#[test]
+fn the_deformed_fe_mesh_is_the_beams() {
+    let set = [("modes".to_string(), 42.0), ("h".to_string(), 1e-3)];
+    let mut model =
+        load_deck_with(&common::deck_path("superelement/pendulum_se.dat"), &set).expect("deck");
+    model.output.vtk = true;
+    let mut h = History::new(1);
+    let report = mecano::solver::run(&model, &mut h).expect("starts");
+    assert!(report.failure.is_none(), "{:?}", report.failure);
+    let integ = mecano::solver::prepare(&model).expect("prepares");
+    let last = h.nodes.last().expect("a state");
+    let mesh = integ
+        .sys
+        .elements
+        .iter()
+        .find_map(|e| e.mesh(last))
+        .expect("the superelement draws its mesh");
+    // Points in the order of the FE nodes' first dofs.
+    let fe = beam();
+    let mut order: Vec<u32> = Vec::new();
+    for &(p, _) in &fe.dofs {
+        if !order.contains(&p) {
+            order.push(p);
+        }
+    }
+    assert_eq!(mesh.points.len(), order.len());
+    assert!(
+        mesh.lines.len() >= order.len() - 1,
+        "{} lines",
+        mesh.lines.len()
+    );
+    let point = |p: u32| mesh.points[order.iter().position(|&q| q == p).expect("FE node")];
+    let node = |id: u32| last[model.nodes.get_index_of(&NodeId(id)).expect("node")].x;
+    let tip = (point(2) - node(2)).norm();
+    eprintln!("recovered interface tip to the model's node 2: {tip:.3e} m");
+    assert!(tip < 1e-9, "{tip}");
+    // The beams deck's generated nodes at the FE nodes' places (the export's mesh).
+    let beams = load_deck_with(
+        &common::deck_path("superelement/pendulum_beams.dat"),
+        &set[1..],
+    )
+    .expect("deck");
+    let mut hb = History::new(1);
+    let rb = mecano::solver::run(&beams, &mut hb).expect("starts");
+    assert!(rb.failure.is_none());
+    let lb = hb.nodes.last().expect("a state");
+    let bound = pendulum_difference(42, 1e-3);
+    for p in 3..=9u32 {
+        let at = beams
+            .nodes
+            .values()
+            .position(|n| (n.position - fe.nodes[&p]).norm() < 1e-12)
+            .expect("a beams node at the FE node's place");
+        let b = lb[at].x;
+        let d = (point(p) - b).norm();
+        eprintln!("FE node {p}: {d:.3e} m from the beams' node (tip bound {bound:.3e})");
+        assert!(d <= bound, "FE node {p}: {d} > {bound}");
+    }
+}

@@ -18,6 +18,7 @@ pub mod fe;
 pub mod frame_model;
 pub mod invariants;
 pub mod kernel;
+pub mod mesh;
 pub mod mtx;
 pub mod rbe;
 #[cfg(test)]
@@ -55,6 +56,8 @@ pub struct Superelement {
     q_ref: Vec<Vector3<f64>>,
     /// Its rotation against its lowest elastic frequency (`spin`).
     spin: spin::SpinWatch,
+    /// The FE mesh's recovery, when the deck writes VTK output.
+    shape: Option<mesh::MeshShape>,
 }
 
 impl Superelement {
@@ -113,7 +116,7 @@ impl Superelement {
                 )));
             }
         }
-        let body = match tr.as_ref() {
+        let (body, basis) = match tr.as_ref() {
             // Interfaces over many nodes: the dense route on TᵀKT, TᵀMT.
             Some(_) if fe.dofs.len() > reduce::DENSE_MAX_DOFS => Err(format!(
                 "RBE2/RBE3 interfaces are reduced densely, up to {} FE dofs; this model has {}",
@@ -127,11 +130,19 @@ impl Superelement {
                     .and_then(|red| {
                         Body::new(&fe, &m, &red, d.interface[0], &d.interface[1..])
                             .map_err(|e| e.to_string())
+                            .map(|b| (b, red.basis))
                     })
             }
-            None => reduce::reduce_body(&fe, &d.interface, d.modes as usize),
+            None => reduce::reduce_body_and_basis(&fe, &d.interface, d.modes as usize),
         }
         .map_err(invalid)?;
+        // The FE mesh for ParaView, only when the deck asks for VTK output (what a deck
+        // does not declare costs nothing: 6 basis rows per FE node).
+        let shape = model
+            .output
+            .vtk
+            .then(|| mesh::MeshShape::new(&fe, &basis, d.interface[0], x_f));
+        drop(basis);
         let nm = d.modal.len();
         let q_ref = nodes[1 + nb..]
             .iter()
@@ -144,6 +155,7 @@ impl Superelement {
             spin: spin::SpinWatch::new(&body),
             body,
             q_ref,
+            shape,
         })
     }
 
@@ -158,6 +170,7 @@ impl Superelement {
             spin: spin::SpinWatch::new(&body),
             body,
             q_ref,
+            shape: None,
         }
     }
 
@@ -480,6 +493,13 @@ impl Element for Superelement {
         if let Some(msg) = self.spin.check(what, ctx.t, &nodes[self.nodes[0]].w) {
             eprintln!("warning: {msg}");
         }
+    }
+
+    fn mesh(&self, nodes: &[NodeState]) -> Option<crate::elements::ElementMesh> {
+        let shape = self.shape.as_ref()?;
+        let q = self.coordinates(nodes);
+        let qd = self.field(nodes, |s, _| s.v);
+        Some(shape.at(&nodes[self.nodes[0]], &q, &qd))
     }
 
     fn own_modes_hz(&self) -> Option<Vec<f64>> {
