@@ -2,7 +2,7 @@
 """The solid plate pendulum of decks/superelement/plate_solid_pendulum.dat in Exudyn, fed the
 same matrices (issue 38's plate target; docs/superelements.md, "The plate against Exudyn").
 
-    python3 plate_exudyn.py --modes K --h H [--tend 0.3] --out tip.csv
+    python3 plate_exudyn.py --modes K --h H [--tend 0.3] [--gravity-moment] --out tip.csv
 
 It reads decks/superelement/plate_solid/ (K.mtx, M.mtx by scipy.io.mmread, nodes.csv) into an
 exudyn.FEM.FEMinterface (nodes['Position'], massMatrix, stiffnessMatrix as scipy CSR, the
@@ -21,6 +21,15 @@ full Newton, fixed step H. The tip is a MarkerSuperElementPosition over the corn
 (weights 1/8: the rigid patch's centroid, mecano-rs's node 2); its position is written at
 every 1e-3 s: columns t, x, y, z.
 
+Gravity. Exudyn's LoadMassProportional on an ObjectFFRFreducedOrder gives the frame the
+moment of the weight about it with the undeformed centre of mass, c0 x R^T m g (as its
+Python user-function route, FEM.py UFforceFFRFreducedOrder, writes: Skew(chiU)); the
+deformation's first moment C1 q, C1 = Phi_t^T M Psi (its mPhitTPsi), is left out of the
+moment (it is in the modal coordinates' load). The potential -g^T(m x0 + R (c0 + C1 q)) gives
+the moment (c0 + C1 q) x R^T g. `--gravity-moment` adds the missing (R C1 q) x g as a
+LoadTorqueVector on the frame node (a user function of q and R): with it the two codes agree
+to their time discretisation (docs/superelements.md, "The plate against Exudyn").
+
 Needs exudyn 1.13.6 and scipy (the Craig-Bampton modes use scipy.sparse.linalg).
 """
 import argparse
@@ -36,7 +45,7 @@ import scipy.sparse
 import exudyn as exu
 from exudyn.FEM import FEMinterface, ObjectFFRFreducedOrderInterface, HCBstaticModeSelection
 from exudyn.itemInterface import (ObjectGround, MarkerBodyRigid, MarkerNodeRigid, ObjectJointGeneric,
-                                  MarkerSuperElementPosition, SensorMarker)
+                                  MarkerSuperElementPosition, SensorMarker, LoadTorqueVector)
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -59,7 +68,7 @@ def read_plate(folder=PLATE):
     return k, m, nodes[:, 1:]
 
 
-def build(mbs, modes, folder=PLATE):
+def build(mbs, modes, folder=PLATE, gravity_moment=False):
     k, m, xyz = read_plate(folder)
     fem = FEMinterface()
     fem.nodes = {"Position": xyz}
@@ -70,6 +79,18 @@ def build(mbs, modes, folder=PLATE):
     cms = ObjectFFRFreducedOrderInterface(fem)
     obj = cms.AddObjectFFRFreducedOrder(mbs, positionRef=[0, 0, 0], initialVelocity=[0, 0, 0],
                                         initialAngularVelocity=[0, 0, 0], gravity=[0, 0, -9.81])
+    if gravity_moment:
+        c1 = np.array(cms.mPhitTPsi)            # 3 x n: the first moment per modal coordinate
+        g = np.array([0, 0, -9.81])
+        nq, nr = obj["nGenericODE2"], obj["nRigidBody"]
+
+        def moment(mbs_, t, load):
+            q = np.array(mbs_.GetNodeOutput(nq, exu.OutputVariableType.Coordinates))
+            rot = np.array(mbs_.GetNodeOutput(nr, exu.OutputVariableType.RotationMatrix)).reshape(3, 3)
+            return list(np.cross(rot @ (c1 @ q), g))
+
+        mr = mbs.AddMarker(MarkerNodeRigid(nodeNumber=nr))
+        mbs.AddLoad(LoadTorqueVector(markerNumber=mr, loadVector=[0, 0, 0], loadVectorUserFunction=moment))
     ground = mbs.AddObject(ObjectGround(referencePosition=[0, 0, 0]))
     mg = mbs.AddMarker(MarkerBodyRigid(bodyNumber=ground, localPosition=[0, 0, 0]))
     mf = mbs.AddMarker(MarkerNodeRigid(nodeNumber=obj["nRigidBody"]))
@@ -82,14 +103,14 @@ def build(mbs, modes, folder=PLATE):
     return sens, fem.eigenValues
 
 
-def run(modes, h, tend=0.3):
+def run(modes, h, tend=0.3, gravity_moment=False):
     """The tip's path, rows (t, x, y, z) at t = j * PERIOD, and a record of the run."""
     steps = int(round(tend / h))
     if abs(steps * h - tend) > 1e-9 or abs(PERIOD / h - round(PERIOD / h)) > 1e-9:
         raise ValueError(f"h = {h} must divide {PERIOD} and {tend}")
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    sens, eig = build(mbs, modes)
+    sens, eig = build(mbs, modes, gravity_moment=gravity_moment)
     mbs.Assemble()
     s = exu.SimulationSettings()
     ti = s.timeIntegration
@@ -122,6 +143,7 @@ def run(modes, h, tend=0.3):
     ok = bool(ok) and abs(mbs.systemData.GetTime() - tend) < 1e-9
     lowest_hz = (np.sqrt(np.abs(eig[:modes])) / (2 * np.pi)).tolist() if modes else []
     return d, dict(code="exudyn", version=exu.__version__, modes=modes, h=h, cpu=round(cpu, 3), ok=ok,
+                   gravity_moment=gravity_moment,
                    fixed_interface_hz=[round(f, 3) for f in lowest_hz])
 
 
@@ -130,9 +152,11 @@ def main():
     ap.add_argument("--modes", type=int, default=6)
     ap.add_argument("--h", type=float, default=1e-3)
     ap.add_argument("--tend", type=float, default=0.3)
+    ap.add_argument("--gravity-moment", action="store_true",
+                    help="add the deformation's moment of the weight about the frame (see above)")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
-    d, rec = run(a.modes, a.h, a.tend)
+    d, rec = run(a.modes, a.h, a.tend, a.gravity_moment)
     if rec["ok"]:
         np.savetxt(a.out, d, delimiter=",", header="t,x,y,z", comments="", fmt="%.16e")
     print(json.dumps(rec))
