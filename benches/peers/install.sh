@@ -21,12 +21,12 @@ ok() { rm -f "$st/$1.fail"; printf '%s\n' "$2" >"$st/$1.ok"; echo "peers: $1 rea
 fail() { rm -f "$st/$1.ok"; printf '%s\n' "$2" >"$st/$1.fail"; echo "peers: $1 NOT available: $2" >&2; }
 
 # --- Exudyn
-if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import exudyn, sys; sys.exit(exudyn.__version__ != '$EXUDYN_VERSION')" 2>/dev/null; then
+if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import exudyn, scipy, sys; sys.exit(exudyn.__version__ != '$EXUDYN_VERSION')" 2>/dev/null; then
   ok exudyn "exudyn $EXUDYN_VERSION (already in $venv)"
 else
   log=$(mktemp)
   if { [ -x "$venv/bin/python" ] || python3 -m venv "$venv"; } >"$log" 2>&1 &&
-    nice -n 10 "$venv/bin/pip" install --disable-pip-version-check -q numpy matplotlib >>"$log" 2>&1 &&
+    nice -n 10 "$venv/bin/pip" install --disable-pip-version-check -q numpy scipy matplotlib >>"$log" 2>&1 &&
     nice -n 10 "$venv/bin/pip" install --disable-pip-version-check -q "exudyn==$EXUDYN_VERSION" >>"$log" 2>&1 &&
     "$venv/bin/python" -c "import exudyn" >>"$log" 2>&1; then
     ok exudyn "exudyn $EXUDYN_VERSION ($venv)"
