@@ -283,6 +283,33 @@ fn a_reduced_set_runs_as_the_full_model() {
     let n = same_histories(&case, "from_fe", "from_set");
     eprintln!("reduced set: {n} histories byte-identical to the full model's");
     assert!(!case.join("set/.mecano-cache").exists());
+    // The plate, whose interfaces are an RBE2 and an RBE3 (interface nodes that are not
+    // FE nodes, placed at their deck nodes): its set runs without the RBE clauses.
+    let plate = dir.join("plate");
+    let src = common::root().join("decks/superelement");
+    std::fs::create_dir_all(plate.join("plate")).expect("dir");
+    for f in FE_FILES {
+        std::fs::copy(src.join("plate").join(f), plate.join("plate").join(f)).expect("copy");
+    }
+    std::fs::copy(src.join("plate_pendulum.dat"), plate.join("p.dat")).expect("copy");
+    let o = Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .current_dir(&plate)
+        .args(["export", "p.dat", "--reduced", "2", "-q", "-o", "set"])
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let deck = std::fs::read_to_string(plate.join("p.dat")).expect("deck");
+    let clauses = " RBE2 1000 SET 1 TO 11 RBE3 2000 SET 65 66 76 77";
+    assert!(deck.contains(clauses));
+    let reduced = deck
+        .replace(clauses, "")
+        .replace("FILES plate", "FILES set");
+    std::fs::write(plate.join("r.dat"), reduced).expect("deck");
+    let (red, _) = ok(&plate, "r.dat", "from_set", &[]);
+    assert_eq!(source(&red), "reduced files");
+    ok(&plate, "p.dat", "from_fe", &[]);
+    let n = same_histories(&plate, "from_fe", "from_set");
+    eprintln!("reduced plate (RBE2, RBE3): {n} histories byte-identical to the full model's");
 }
 
 /// Bad reduced sets: located errors at the card, exit 2, nothing written.

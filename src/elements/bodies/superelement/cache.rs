@@ -364,4 +364,63 @@ mod tests {
         v[8] = 9;
         assert!(why(&v).contains("version 9"));
     }
+
+    /// Every input of the key changes it: the files' bytes, the interface, its places, the
+    /// modes, each part of an RBE clause. What the deck says picks the file (the slot),
+    /// the files' bytes only the key within it.
+    #[test]
+    fn every_input_changes_the_key() {
+        use crate::model::RbeSpec;
+        let d = SuperelementData {
+            dir: PathBuf::from("fe"),
+            modes: 4,
+            interface: vec![1, 2],
+            modal: Vec::new(),
+            rbe: vec![RbeSpec {
+                kind: RbeKind::Average,
+                node: 2,
+                set: SetSpec::Nodes(vec![5, 6, 7]),
+                weights: vec![1.0, 2.0, 3.0],
+            }],
+            cache: true,
+        };
+        let texts: [String; 4] = ["K".into(), "M".into(), "n".into(), "d".into()];
+        let places = [Vector3::zeros(), Vector3::x()];
+        let base = entry(&d, &texts, &places);
+        assert_eq!(base, entry(&d, &texts, &places), "deterministic");
+        assert!(base.path.starts_with("fe/.mecano-cache"));
+        let mut keys = vec![base.clone()];
+        for i in 0..4 {
+            let mut t = texts.clone();
+            t[i].push(' ');
+            let e = entry(&d, &t, &places);
+            assert_eq!(e.path, base.path, "the files' bytes keep the slot");
+            keys.push(e);
+        }
+        let mut p = places;
+        p[1].x = f64::from_bits(p[1].x.to_bits() + 1);
+        keys.push(entry(&d, &texts, &p));
+        let edits: Vec<Box<dyn Fn(&mut SuperelementData)>> = vec![
+            Box::new(|d| d.modes = 5),
+            Box::new(|d| d.interface = vec![2, 1]),
+            Box::new(|d| d.rbe[0].kind = RbeKind::Rigid),
+            Box::new(|d| d.rbe[0].node = 1),
+            Box::new(|d| d.rbe[0].set = SetSpec::Nodes(vec![5, 6, 8])),
+            Box::new(|d| d.rbe[0].set = SetSpec::Within(0.1)),
+            Box::new(|d| d.rbe[0].weights[2] = 3.5),
+            Box::new(|d| d.rbe.clear()),
+        ];
+        for edit in edits {
+            let mut e = d.clone();
+            edit(&mut e);
+            let k = entry(&e, &texts, &places);
+            assert_ne!(k.path, base.path, "the deck's reduction picks the slot");
+            keys.push(k);
+        }
+        for (i, a) in keys.iter().enumerate() {
+            for b in &keys[i + 1..] {
+                assert_ne!(a.key, b.key);
+            }
+        }
+    }
 }
