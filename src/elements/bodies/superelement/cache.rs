@@ -284,7 +284,7 @@ pub fn decode(bytes: &[u8]) -> Result<([u8; 32], Body), String> {
 #[derive(Debug)]
 pub enum Lookup {
     /// The body of this key.
-    Hit(Body),
+    Hit(Box<Body>),
     /// No file, or one of another key (an input or mecano-rs changed).
     Miss,
     /// A file that is not a valid cache (why): to warn about, then overwrite.
@@ -299,7 +299,7 @@ pub fn load(e: &Entry) -> Lookup {
         Err(err) => return Lookup::Invalid(err.to_string()),
     };
     match decode(&bytes) {
-        Ok((key, body)) if key == e.key => Lookup::Hit(body),
+        Ok((key, body)) if key == e.key => Lookup::Hit(Box::new(body)),
         Ok(_) => Lookup::Miss,
         Err(why) => Lookup::Invalid(why),
     }
@@ -400,7 +400,8 @@ mod tests {
         let mut p = places;
         p[1].x = f64::from_bits(p[1].x.to_bits() + 1);
         keys.push(entry(&d, &texts, &p));
-        let edits: Vec<Box<dyn Fn(&mut SuperelementData)>> = vec![
+        type Edit = Box<dyn Fn(&mut SuperelementData)>;
+        let edits: Vec<Edit> = vec![
             Box::new(|d| d.modes = 5),
             Box::new(|d| d.interface = vec![2, 1]),
             Box::new(|d| d.rbe[0].kind = RbeKind::Rigid),

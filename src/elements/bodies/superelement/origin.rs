@@ -35,7 +35,7 @@ pub fn body_of(
     let entry = d.cache.then(|| cache::entry(d, &texts, &places));
     if let Some(e) = &entry {
         match cache::load(e) {
-            Lookup::Hit(body) => return Ok((body, Source::Cache(e.path.clone()))),
+            Lookup::Hit(body) => return Ok((*body, Source::Cache(e.path.clone()))),
             Lookup::Miss => {}
             Lookup::Invalid(why) => eprintln!(
                 "warning: {}: the reduction cache {} is not valid ({why}): reduced again, and the cache rewritten",
