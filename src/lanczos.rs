@@ -76,30 +76,43 @@ pub(crate) struct Basis {
 }
 
 impl Basis {
-    /// Projects `w` on the basis twice (Gram–Schmidt), returning the summed coefficients;
-    /// `mw`, when given, is `M w` and is kept so (`M q` is stored: no product).
-    pub(crate) fn project(&self, w: &mut [f64], mut mw: Option<&mut [f64]>) -> Vec<f64> {
-        let mut coef = vec![0.0; self.q.len()];
-        for _ in 0..2 {
-            for (i, (q, mq)) in self.q.iter().zip(&self.mq).enumerate() {
-                let c = dot(mq, w);
-                axpy(w, -c, q);
-                if let Some(mw) = mw.as_deref_mut() {
-                    axpy(mw, -c, mq);
-                }
-                coef[i] += c;
-            }
-        }
-        coef
+    /// Projects the block `ws` on the basis twice (block classical Gram–Schmidt, CGS2:
+    /// "twice is enough", Giraud, Langou & Rozložník, Comput. Math. Appl. 50, 2005),
+    /// returning the summed coefficients `C` (basis × block): `w_j ← w_j − Σ_i c_ij q_i`
+    /// with `c_ij = (M q_i)ᵀ w_j`. `mws`, when given, are the `M w_j` and are kept so
+    /// (`M q` is stored: no product). The rows are swept in chunks that stay in cache with
+    /// the whole block, so that each pass reads the basis once for the whole block (one
+    /// vector at a time, the orthogonalisation was bound by memory traffic: 40 % of a
+    /// 100,000-dof superelement's reduction).
+    pub(crate) fn project_block(
+        &self,
+        ws: &mut [Vec<f64>],
+        mws: Option<&mut [Vec<f64>]>,
+    ) -> DMatrix<f64> {
+        project_on(&self.q, &self.mq, ws, mws)
     }
 
     /// `M`-orthonormalises `ws` (each with its mass image `M w`) against the basis and
     /// each other, appending those that are independent; returns how many were appended.
+    /// The block is projected on the basis at once ([`Basis::project_block`]), then each
+    /// vector on those of the block appended before it.
     pub(crate) fn extend(&mut self, ws: Vec<(Vec<f64>, Vec<f64>)>) -> usize {
+        let (mut w, mut mw): (Vec<Vec<f64>>, Vec<Vec<f64>>) = ws.into_iter().unzip();
+        let n0: Vec<f64> = w
+            .iter()
+            .zip(&mw)
+            .map(|(w, mw)| dot(mw, w).max(0.0).sqrt())
+            .collect();
+        self.project_block(&mut w, Some(&mut mw));
+        let start = self.q.len();
         let mut added = 0;
-        for (mut w, mut mw) in ws {
-            let n0 = dot(&mw, &w).max(0.0).sqrt();
-            self.project(&mut w, Some(&mut mw));
+        for ((mut w, mut mw), n0) in w.into_iter().zip(mw).zip(n0) {
+            project_on(
+                &self.q[start..],
+                &self.mq[start..],
+                std::slice::from_mut(&mut w),
+                Some(std::slice::from_mut(&mut mw)),
+            );
             let n1 = dot(&mw, &w).max(0.0).sqrt();
             if n1 <= DROP * n0 || n1 == 0.0 {
                 continue;
@@ -112,15 +125,24 @@ impl Basis {
         added
     }
 
-    /// `Σ_j s_j q_j` over the basis.
-    pub(crate) fn combine(vs: &[Vec<f64>], s: impl Iterator<Item = f64>, n: usize) -> Vec<f64> {
-        let mut y = vec![0.0; n];
-        for (v, sj) in vs.iter().zip(s) {
-            if sj != 0.0 {
-                axpy(&mut y, sj, v);
+    /// `Y = V S`: column `k` of `Y` is `Σ_j s_jk v_j` (`S`: `vs.len()` × k). Swept in row
+    /// chunks that stay in cache, as [`Basis::project_block`] (one combination at a time,
+    /// a restart read the whole basis once per Ritz vector).
+    pub(crate) fn combine(vs: &[Vec<f64>], s: &DMatrix<f64>, n: usize) -> Vec<Vec<f64>> {
+        const CHUNK: usize = 2048;
+        let mut ys = vec![vec![0.0; n]; s.ncols()];
+        for r0 in (0..n).step_by(CHUNK) {
+            let r1 = (r0 + CHUNK).min(n);
+            for (j, v) in vs.iter().enumerate() {
+                for (k, y) in ys.iter_mut().enumerate() {
+                    let c = s[(j, k)];
+                    if c != 0.0 {
+                        axpy(&mut y[r0..r1], c, &v[r0..r1]);
+                    }
+                }
             }
         }
-        y
+        ys
     }
 }
 
@@ -153,7 +175,7 @@ pub trait ShiftInvert {
 pub fn largest<O: ShiftInvert>(
     op: &mut O,
     count: usize,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), O::Error> {
+) -> Result<Eigenpairs, O::Error> {
     let mut block = BLOCK.min(count.max(1));
     loop {
         let (theta, basis) = match iterate(op, count, block, None)? {
@@ -181,6 +203,9 @@ pub fn largest<O: ShiftInvert>(
         return Ok((theta, basis));
     }
 }
+
+/// Ritz values and their `M`-orthonormal vectors.
+pub type Eigenpairs = (Vec<f64>, Vec<Vec<f64>>);
 
 /// What [`iterate`] ends with.
 pub enum Outcome {
@@ -232,15 +257,16 @@ pub fn iterate<O: ShiftInvert>(
         let mut hn = DMatrix::<f64>::zeros(m_all, m_all);
         hn.view_mut((0, 0), (m_old, m_old)).copy_from(&h);
         for &j in &pending {
-            let mut w = op.apply_mass(&q.mq[j].clone())?;
-            let coef = q.project(&mut w, None);
-            for (i, cf) in coef.into_iter().enumerate() {
-                hn[(i, j)] = cf;
+            ws.push(op.apply_mass(&q.mq[j].clone())?);
+        }
+        let coef = q.project_block(&mut ws, None);
+        for (a, &j) in pending.iter().enumerate() {
+            for i in 0..m_all {
+                hn[(i, j)] = coef[(i, a)];
                 if i < m_old {
-                    hn[(j, i)] = cf;
+                    hn[(j, i)] = coef[(i, a)];
                 }
             }
-            ws.push(w);
         }
         let h_sym = (&hn + hn.transpose()) * 0.5;
         h = h_sym.clone();
@@ -266,15 +292,11 @@ pub fn iterate<O: ShiftInvert>(
             })
             .count();
         let ritz = |idx: &[usize]| -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
-            idx.iter()
-                .map(|&i| {
-                    let s = eig.eigenvectors.column(i);
-                    (
-                        Basis::combine(&q.q, s.iter().copied(), nn),
-                        Basis::combine(&q.mq, s.iter().copied(), nn),
-                    )
-                })
-                .unzip()
+            let sel = DMatrix::from_fn(m_all, idx.len(), |j, k| eig.eigenvectors[(j, idx[k])]);
+            (
+                Basis::combine(&q.q, &sel, nn),
+                Basis::combine(&q.mq, &sel, nn),
+            )
         };
         if converged == count {
             let theta = order[..count].iter().map(|&i| eig.eigenvalues[i]).collect();
@@ -328,4 +350,46 @@ pub fn iterate<O: ShiftInvert>(
             }
         }
     }
+}
+
+/// [`Basis::project_block`] on the basis `(q, mq)`.
+fn project_on(
+    q: &[Vec<f64>],
+    mq: &[Vec<f64>],
+    ws: &mut [Vec<f64>],
+    mut mws: Option<&mut [Vec<f64>]>,
+) -> DMatrix<f64> {
+    const CHUNK: usize = 2048;
+    let (m, b) = (q.len(), ws.len());
+    let n = ws.first().map_or(0, Vec::len);
+    let mut total = DMatrix::zeros(m, b);
+    if m == 0 || b == 0 {
+        return total;
+    }
+    for _ in 0..2 {
+        let mut c = DMatrix::<f64>::zeros(m, b);
+        for r0 in (0..n).step_by(CHUNK) {
+            let r1 = (r0 + CHUNK).min(n);
+            for (i, mq) in mq.iter().enumerate() {
+                for (j, w) in ws.iter().enumerate() {
+                    c[(i, j)] += dot(&mq[r0..r1], &w[r0..r1]);
+                }
+            }
+        }
+        for r0 in (0..n).step_by(CHUNK) {
+            let r1 = (r0 + CHUNK).min(n);
+            for i in 0..m {
+                for (j, w) in ws.iter_mut().enumerate() {
+                    axpy(&mut w[r0..r1], -c[(i, j)], &q[i][r0..r1]);
+                }
+                if let Some(mws) = mws.as_deref_mut() {
+                    for (j, mw) in mws.iter_mut().enumerate() {
+                        axpy(&mut mw[r0..r1], -c[(i, j)], &mq[i][r0..r1]);
+                    }
+                }
+            }
+        }
+        total += c;
+    }
+    total
 }

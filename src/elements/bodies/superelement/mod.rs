@@ -16,6 +16,7 @@
 
 pub mod cache;
 pub mod fe;
+pub mod frame_model;
 pub mod invariants;
 pub mod kernel;
 pub mod mtx;
@@ -26,6 +27,8 @@ mod rbe_tests;
 pub mod reduce;
 pub mod reduced;
 pub mod sparse;
+#[cfg(test)]
+mod sparse_tests;
 pub mod spin;
 #[cfg(test)]
 mod tests;

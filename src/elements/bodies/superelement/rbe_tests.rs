@@ -4,11 +4,11 @@
 //! and the weighted least-squares fit solved here by an SVD.
 
 use super::fe::FeModel;
+use super::frame_model::{A, E, G, IY, IZ, J, frame, l_frame};
 use super::invariants::Body;
 use super::mtx::SymMatrix;
 use super::rbe::{self, Rbe, RbeError, RbeKind, SetSpec, Transform};
 use super::reduce::lowest_eigenvalues;
-use super::tests::{A, E, G, IY, IZ, J, frame, l_frame};
 use nalgebra::{DMatrix, Matrix6, Vector3};
 
 /// `beams` FE models side by side in one: node `p` of model `b` becomes `100 (b + 1) + p`.

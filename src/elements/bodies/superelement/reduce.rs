@@ -165,19 +165,18 @@ fn sub(a: &DMatrix<f64>, rows: &[usize], cols: &[usize]) -> DMatrix<f64> {
 
 /// The FE rows split for the reduction: the frame node's, the other interface nodes', the
 /// interior (ascending).
-pub(super) struct Partition {
+pub struct Partition {
+    /// The frame node's six rows.
     pub frame: [usize; 6],
+    /// The other interface nodes' rows, six per node.
     pub boundary: Vec<usize>,
+    /// The interior rows, ascending.
     pub interior: Vec<usize>,
 }
 
 /// Splits `fe`'s rows about `interface` (the first the frame node), checking the interface
 /// and that `modes` interior modes exist.
-pub(super) fn partition(
-    fe: &FeModel,
-    interface: &[u32],
-    modes: usize,
-) -> Result<Partition, ReduceError> {
+pub fn partition(fe: &FeModel, interface: &[u32], modes: usize) -> Result<Partition, ReduceError> {
     let n = fe.dofs.len();
     for (i, a) in interface.iter().enumerate() {
         if interface[..i].contains(a) {

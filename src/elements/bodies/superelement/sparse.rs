@@ -118,7 +118,7 @@ pub fn cholesky(n: usize, a: &[(usize, usize, f64)]) -> Result<Llt<usize, f64>, 
 }
 
 /// The blocks of `fe`'s matrices the reduction needs, sparse.
-pub(super) struct Blocks {
+pub struct Blocks {
     /// `K_II`, lower triangle, interior numbering.
     pub kii: Vec<(usize, usize, f64)>,
     /// `M_II`, lower triangle, interior numbering.
@@ -128,7 +128,7 @@ pub(super) struct Blocks {
 }
 
 /// Splits `K`, `M` into the interior and interior–boundary blocks.
-pub(super) fn blocks(fe: &FeModel, p: &Partition) -> Blocks {
+pub fn blocks(fe: &FeModel, p: &Partition) -> Blocks {
     let n = fe.dofs.len();
     let (mut ii, mut bi) = (vec![usize::MAX; n], vec![usize::MAX; n]);
     p.interior.iter().enumerate().for_each(|(a, &r)| ii[r] = a);

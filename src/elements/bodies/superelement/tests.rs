@@ -4,6 +4,7 @@
 //! power balance of the inertia forces, a finite difference of the residual.
 
 use super::fe::FeModel;
+pub(super) use super::frame_model::{A, RHO, l_frame};
 use super::invariants::Body;
 use super::mtx::SymMatrix;
 use super::reduce::{lowest_eigenvalues, reduce};
@@ -11,140 +12,6 @@ use super::*;
 use crate::elements::testing::{Lcg, check_tangent, dyn_ctx, random_states, static_ctx};
 use crate::rotation;
 use nalgebra::{DMatrix, Matrix3, Vector3};
-
-/// Section of the test frame: E, G, A, Iy, Iz, J, ρ.
-pub(super) const E: f64 = 2.1e11;
-pub(super) const G: f64 = 8.0e10;
-pub(super) const A: f64 = 1e-4;
-pub(super) const IY: f64 = 8.3e-10;
-pub(super) const IZ: f64 = 2.1e-9;
-pub(super) const J: f64 = 2.5e-9;
-pub(super) const RHO: f64 = 7800.0;
-
-/// A 3D frame: the polyline through `corners`, each segment in `per` elements; FE nodes
-/// numbered 1, 2, … along it.
-pub(super) fn frame(corners: &[Vector3<f64>], per: usize) -> FeModel {
-    let mut pts = vec![corners[0]];
-    for w in corners.windows(2) {
-        for i in 1..=per {
-            pts.push(w[0] + (w[1] - w[0]) * (i as f64 / per as f64));
-        }
-    }
-    let n = 6 * pts.len();
-    let (mut k, mut m) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-    for e in 0..pts.len() - 1 {
-        let d = pts[e + 1] - pts[e];
-        let l = d.norm();
-        let ex = d / l;
-        let t = if ex.z.abs() < 0.9 {
-            Vector3::z()
-        } else {
-            Vector3::x()
-        };
-        let ey = t.cross(&ex).normalize();
-        let ez = ex.cross(&ey);
-        let lam = Matrix3::from_rows(&[ex.transpose(), ey.transpose(), ez.transpose()]);
-        let (kl, ml) = local(l);
-        let mut tt = DMatrix::zeros(12, 12);
-        for b in 0..4 {
-            tt.view_mut((3 * b, 3 * b), (3, 3)).copy_from(&lam);
-        }
-        let kg = tt.transpose() * kl * &tt;
-        let mg = tt.transpose() * ml * &tt;
-        for i in 0..12 {
-            for j in 0..12 {
-                let (gi, gj) = (6 * e + i, 6 * e + j);
-                k[(gi, gj)] += kg[(i, j)];
-                m[(gi, gj)] += mg[(i, j)];
-            }
-        }
-    }
-    FeModel {
-        k: SymMatrix::from_dense(&k, 0.0),
-        m: SymMatrix::from_dense(&m, 0.0),
-        nodes: pts
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (i as u32 + 1, *p))
-            .collect(),
-        dofs: (0..n)
-            .map(|r| ((r / 6) as u32 + 1, (r % 6) as u8))
-            .collect(),
-    }
-}
-
-/// The local 12×12 stiffness and consistent mass of a 3D Euler–Bernoulli beam.
-fn local(l: f64) -> (DMatrix<f64>, DMatrix<f64>) {
-    let (mut k, mut m) = (DMatrix::zeros(12, 12), DMatrix::zeros(12, 12));
-    let put2 = |a: &mut DMatrix<f64>, dofs: [usize; 2], c: f64, b: [[f64; 2]; 2]| {
-        for i in 0..2 {
-            for j in 0..2 {
-                a[(dofs[i], dofs[j])] += c * b[i][j];
-            }
-        }
-    };
-    put2(&mut k, [0, 6], E * A / l, [[1.0, -1.0], [-1.0, 1.0]]);
-    put2(&mut k, [3, 9], G * J / l, [[1.0, -1.0], [-1.0, 1.0]]);
-    put2(&mut m, [0, 6], RHO * A * l / 6.0, [[2.0, 1.0], [1.0, 2.0]]);
-    put2(
-        &mut m,
-        [3, 9],
-        RHO * (IY + IZ) * l / 6.0,
-        [[2.0, 1.0], [1.0, 2.0]],
-    );
-    let kb = |ei: f64| {
-        let c = ei / l.powi(3);
-        [
-            [12.0 * c, 6.0 * l * c, -12.0 * c, 6.0 * l * c],
-            [6.0 * l * c, 4.0 * l * l * c, -6.0 * l * c, 2.0 * l * l * c],
-            [-12.0 * c, -6.0 * l * c, 12.0 * c, -6.0 * l * c],
-            [6.0 * l * c, 2.0 * l * l * c, -6.0 * l * c, 4.0 * l * l * c],
-        ]
-    };
-    let c = RHO * A * l / 420.0;
-    let mb = [
-        [156.0 * c, 22.0 * l * c, 54.0 * c, -13.0 * l * c],
-        [
-            22.0 * l * c,
-            4.0 * l * l * c,
-            13.0 * l * c,
-            -3.0 * l * l * c,
-        ],
-        [54.0 * c, 13.0 * l * c, 156.0 * c, -22.0 * l * c],
-        [
-            -13.0 * l * c,
-            -3.0 * l * l * c,
-            -22.0 * l * c,
-            4.0 * l * l * c,
-        ],
-    ];
-    let put4 = |a: &mut DMatrix<f64>, dofs: [usize; 4], b: [[f64; 4]; 4], sign: [f64; 4]| {
-        for i in 0..4 {
-            for j in 0..4 {
-                a[(dofs[i], dofs[j])] += sign[i] * sign[j] * b[i][j];
-            }
-        }
-    };
-    // v, θz (plane xy) and w, θy (plane xz: θy = −w′).
-    put4(&mut k, [1, 5, 7, 11], kb(E * IZ), [1.0; 4]);
-    put4(&mut m, [1, 5, 7, 11], mb, [1.0; 4]);
-    put4(&mut k, [2, 4, 8, 10], kb(E * IY), [1.0, -1.0, 1.0, -1.0]);
-    put4(&mut m, [2, 4, 8, 10], mb, [1.0, -1.0, 1.0, -1.0]);
-    (k, m)
-}
-
-/// An L-shaped frame in the xy plane, 1 m legs, `per` elements each: FE nodes 1 (origin)
-/// to 2·per + 1.
-pub(super) fn l_frame(per: usize) -> FeModel {
-    frame(
-        &[
-            Vector3::zeros(),
-            Vector3::new(1.0, 0.0, 0.0),
-            Vector3::new(1.0, 0.8, 0.3),
-        ],
-        per,
-    )
-}
 
 fn body_of(fe: &FeModel, interface: &[u32], modes: usize) -> Body {
     let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
