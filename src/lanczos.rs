@@ -172,10 +172,7 @@ pub trait ShiftInvert {
 /// The `count` eigenpairs of largest `|θ|` of `T` (`θ`, `M`-orthonormal vectors), by the
 /// block Lanczos of this module at a fixed shift, the block doubled while a cluster of
 /// converged values fills it (module docs).
-pub fn largest<O: ShiftInvert>(
-    op: &mut O,
-    count: usize,
-) -> Result<Eigenpairs, O::Error> {
+pub fn largest<O: ShiftInvert>(op: &mut O, count: usize) -> Result<Eigenpairs, O::Error> {
     let mut block = BLOCK.min(count.max(1));
     loop {
         let (theta, basis) = match iterate(op, count, block, None)? {

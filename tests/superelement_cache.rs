@@ -371,7 +371,7 @@ fn bad_reduced_sets_are_refused_located() {
         (
             "other_interface",
             Box::new(|c: &Path| replace(&c.join("set/interface.csv"), "\n2,", "\n3,")),
-            "lists the interface FE nodes [1.0, 3.0], the deck's INTERFACE [1, 2]",
+            "lists the interface FE nodes 1, 3, the deck's INTERFACE 1, 2 (the same nodes",
         ),
         (
             "misplaced",
@@ -418,4 +418,37 @@ fn bad_reduced_sets_are_refused_located() {
             "{name}: wrote its output directory"
         );
     }
+}
+
+/// `CACHE OFF` reads to a model without cache, prints back as itself (the writer), and is
+/// refused with anything but ON or OFF after it; the default is ON.
+#[test]
+fn cache_off_round_trips_through_the_writer() {
+    use mecano::deck::{parse_deck, strip_spans, write_deck};
+    use mecano::model::ElementKind;
+    let deck = |tail: &str| {
+        format!(
+            "TITLE c\nNODES\n  1 0 0 0\n  2 1 0 0\nELEMENTS\n  1 SUPERELEMENT FILES beam MODES 2 INTERFACE 1 1 2 2{tail}\nANALYSIS DYNAMIC STEP 1e-3 END 1e-2\nEND\n"
+        )
+    };
+    let cache_of = |m: &mecano::model::Model| match &m.elements[0].kind {
+        ElementKind::Superelement(d) => d.cache,
+        _ => panic!("a superelement"),
+    };
+    let mut first = parse_deck(&deck(" CACHE OFF"), "c.dat").expect("valid");
+    assert!(!cache_of(&first));
+    let text = write_deck(&first);
+    assert!(text.contains("CACHE OFF"), "{text}");
+    let mut second = parse_deck(&text, "written").expect("valid");
+    strip_spans(&mut first);
+    strip_spans(&mut second);
+    assert_eq!(first, second);
+    let on = parse_deck(&deck(" CACHE ON"), "c.dat").expect("valid");
+    assert!(cache_of(&on) && cache_of(&parse_deck(&deck(""), "c.dat").expect("valid")));
+    assert!(!write_deck(&on).contains("CACHE"));
+    let bad = parse_deck(&deck(" CACHE MAYBE"), "c.dat").expect_err("refused");
+    assert!(
+        format!("{bad:?}").contains("ON or OFF after CACHE"),
+        "{bad:?}"
+    );
 }

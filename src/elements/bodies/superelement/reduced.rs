@@ -137,9 +137,18 @@ pub fn read(
     let deck: Vec<f64> = d.interface.iter().map(|&a| f64::from(a)).collect();
     if listed != deck {
         return Err(ReducedError::Invalid(format!(
-            "{} lists the interface FE nodes {listed:?}, the deck's INTERFACE {:?} (the same nodes in the same order, the frame node first)",
+            "{} lists the interface FE nodes {}, the deck's INTERFACE {} (the same nodes in the same order, the frame node first)",
             p(5).display(),
+            listed
+                .iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
             d.interface
+                .iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         )));
     }
     let x: Vec<Vector3<f64>> = rows
