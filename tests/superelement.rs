@@ -124,6 +124,88 @@ fn modes_of_the_superelement_are_the_beams() {
     }
 }
 
+/// `modes` and `--check` list a superelement's own (fixed-interface) modes: for the bar
+/// clamped at its frame node with 9 modes kept, they are the clamped bar's 8 lowest modes
+/// computed on the beams (an independent route: the assembled beams' eigen-solve against
+/// the reduction's interior one) to the listing's 7 printed digits (1e-6), and `--check` states each one's samples per
+/// period at the deck's step, `1/(f h)`, to its 4 printed digits.
+#[test]
+fn a_superelements_own_modes_are_listed_with_the_steps_resolution() {
+    let dir = common::TempDir::new("se_own_modes");
+    let beams_dir = dir.join("b");
+    let o = bin()
+        .arg("modes")
+        .arg(common::deck_path("superelement/cantilever_beams.dat"))
+        .args(["-q", "--count", "8", "-o"])
+        .arg(&beams_dir)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let beams: Vec<f64> = std::fs::read_to_string(beams_dir.join("modes.csv"))
+        .expect("modes.csv")
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .nth(2)
+                .expect("column")
+                .parse()
+                .expect("number")
+        })
+        .collect();
+    // The listing: "element 1: 9 fixed-interface modes …", then one row per mode.
+    let listed = |stdout: &str| -> Vec<Vec<f64>> {
+        let mut lines = stdout
+            .lines()
+            .skip_while(|l| !l.contains("fixed-interface modes of its own"));
+        assert!(lines.next().is_some(), "no listing in:\n{stdout}");
+        lines
+            .map_while(|l| {
+                let cells: Vec<f64> = l
+                    .split_whitespace()
+                    .filter_map(|c| c.parse().ok())
+                    .collect();
+                (l.starts_with("  ") && cells.len() >= 2).then_some(cells)
+            })
+            .collect()
+    };
+    let o = bin()
+        .arg("modes")
+        .arg(common::deck_path("superelement/cantilever_se.dat"))
+        .args(["--count", "8", "--set", "modes=9", "-o"])
+        .arg(dir.join("s"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = listed(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!(rows.len(), 9);
+    for (i, b) in beams.iter().enumerate() {
+        let e = (rows[i][1] - b).abs() / b;
+        assert!(
+            e < 1e-6,
+            "own mode {}: {} Hz vs the beams' {b} Hz",
+            i + 1,
+            rows[i][1]
+        );
+    }
+    // --check on the pendulum (h = 1e-3 s, 4 modes): samples per period 1/(f h).
+    let o = bin()
+        .arg("--check")
+        .arg(common::deck_path("superelement/pendulum_se.dat"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = listed(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!(rows.len(), 4);
+    for r in &rows {
+        let (f, samples) = (r[1], r[2]);
+        assert!(
+            (samples * f * 1e-3 - 1.0).abs() < 1e-3,
+            "{f} Hz: {samples} samples per period at h = 1e-3 s"
+        );
+    }
+}
+
 /// Runs `deck` with the overrides into memory; node `node`'s positions.
 fn positions(deck: &str, set: &[(String, f64)], node: u32) -> (Vec<f64>, Vec<[f64; 3]>) {
     let model = load_deck_with(&common::deck_path(deck), set).expect("deck");
@@ -531,5 +613,71 @@ fn a_superelement_spun_past_its_first_frequency_is_said() {
         );
         // Unstable: the strain takes a visible share of the energy; stable: round-off.
         assert_eq!(strain > 1e-6 * energy, warned, "Ω = {omega}: {strain} J");
+    }
+}
+
+/// The deformed FE mesh for ParaView (`OUTPUT … VTK`): the pendulum as a superelement of
+/// all 42 modes, its FE nodes recovered from the frame and the elastic coordinates at the
+/// end (0.4 s). The interface tip's recovered place is the model's node 2 (the interface
+/// constraint, solved to Newton's tolerance), and the bar's interior FE nodes 3–9 lie on
+/// the beams deck's nodes 3–9 within the largest distance of the two decks' tip paths (the
+/// same two discretisations; the tip, farthest from the hinge, moves most).
+#[test]
+fn the_deformed_fe_mesh_is_the_beams() {
+    let set = [("modes".to_string(), 42.0), ("h".to_string(), 1e-3)];
+    let mut model =
+        load_deck_with(&common::deck_path("superelement/pendulum_se.dat"), &set).expect("deck");
+    model.output.vtk = true;
+    let mut h = History::new(1);
+    let report = mecano::solver::run(&model, &mut h).expect("starts");
+    assert!(report.failure.is_none(), "{:?}", report.failure);
+    let integ = mecano::solver::prepare(&model).expect("prepares");
+    let last = h.nodes.last().expect("a state");
+    let mesh = integ
+        .sys
+        .elements
+        .iter()
+        .find_map(|e| e.mesh(last))
+        .expect("the superelement draws its mesh");
+    // Points in the order of the FE nodes' first dofs.
+    let fe = beam();
+    let mut order: Vec<u32> = Vec::new();
+    for &(p, _) in &fe.dofs {
+        if !order.contains(&p) {
+            order.push(p);
+        }
+    }
+    assert_eq!(mesh.points.len(), order.len());
+    assert!(
+        mesh.lines.len() >= order.len() - 1,
+        "{} lines",
+        mesh.lines.len()
+    );
+    let point = |p: u32| mesh.points[order.iter().position(|&q| q == p).expect("FE node")];
+    let node = |id: u32| last[model.nodes.get_index_of(&NodeId(id)).expect("node")].x;
+    let tip = (point(2) - node(2)).norm();
+    eprintln!("recovered interface tip to the model's node 2: {tip:.3e} m");
+    assert!(tip < 1e-9, "{tip}");
+    // The beams deck's generated nodes at the FE nodes' places (the export's mesh).
+    let beams = load_deck_with(
+        &common::deck_path("superelement/pendulum_beams.dat"),
+        &set[1..],
+    )
+    .expect("deck");
+    let mut hb = History::new(1);
+    let rb = mecano::solver::run(&beams, &mut hb).expect("starts");
+    assert!(rb.failure.is_none());
+    let lb = hb.nodes.last().expect("a state");
+    let bound = pendulum_difference(42, 1e-3);
+    for p in 3..=9u32 {
+        let at = beams
+            .nodes
+            .values()
+            .position(|n| (n.position - fe.nodes[&p]).norm() < 1e-12)
+            .expect("a beams node at the FE node's place");
+        let b = lb[at].x;
+        let d = (point(p) - b).norm();
+        eprintln!("FE node {p}: {d:.3e} m from the beams' node (tip bound {bound:.3e})");
+        assert!(d <= bound, "FE node {p}: {d} > {bound}");
     }
 }

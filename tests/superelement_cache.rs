@@ -135,6 +135,17 @@ fn a_second_run_reads_the_cache_and_a_changed_input_does_not() {
     let (back, _) = ok(&case, "d.dat", "out6", &[]);
     assert_eq!(source(&back), "cache");
     same_histories(&case, "out3", "out6");
+    // A deck that writes VTK needs the basis over the mesh, which the cache does not hold:
+    // it reduces (its deformed mesh drawn), and the cache stays the same file.
+    replace(
+        &case.join("d.dat"),
+        "OUTPUT NODES 1 2 ELEMENTS 2",
+        "OUTPUT NODES 1 2 ELEMENTS 2 VTK",
+    );
+    let (vtk, _) = ok(&case, "d.dat", "out7", &[]);
+    assert_eq!(source(&vtk), "computed");
+    assert_eq!(vtk["cache_file"], back["cache_file"]);
+    assert!(case.join("out7/vtk").is_dir());
 }
 
 /// A cache file that is torn, damaged or foreign is ignored with a warning, the body

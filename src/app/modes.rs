@@ -218,12 +218,62 @@ pub fn print_integrators(out: &mut dyn std::io::Write, a: &ModalAnalysis, st: De
     }
 }
 
-/// The lines `--check` adds: the mesh's highest frequency and what the deck's step
-/// resolves of the lowest five modes, about the initial state.
+/// The modes elements carry as their own coordinates (a superelement's kept
+/// fixed-interface modes, [`crate::elements::Element::own_modes_hz`]), element by element,
+/// with what the deck's step resolves of each ([`crate::modes::hht::resolution`]: samples
+/// per period, the scheme's numerical damping ratio and period error) — the highest kept
+/// mode is the one a step must resolve, or the scheme must damp.
+pub fn print_own_modes(
+    out: &mut dyn std::io::Write,
+    elements: &[Box<dyn crate::elements::Element>],
+    step: Option<DeckStep>,
+) {
+    for el in elements {
+        let Some(hz) = el.own_modes_hz() else {
+            continue;
+        };
+        let _ = writeln!(
+            out,
+            "element {}: {} fixed-interface modes of its own (a reduced body's coordinates){}",
+            el.id().0,
+            hz.len(),
+            match step {
+                Some(st) => format!(
+                    "; at the deck's step ({}, h = {:e} s): samples per period, numerical damping ratio, period error",
+                    st.scheme, st.h
+                ),
+                None => String::new(),
+            }
+        );
+        for (i, f) in hz.iter().enumerate() {
+            match step {
+                Some(st) => {
+                    let r = crate::modes::hht::resolution(&st.scheme, st.h, *f);
+                    let (damping, period) = resolution_cells(&r);
+                    let _ = writeln!(
+                        out,
+                        "  {:5}  {:12.6e}  {:10.3e}  {damping:>11}  {period:>10}",
+                        i + 1,
+                        f,
+                        r.samples_per_period
+                    );
+                }
+                None => {
+                    let _ = writeln!(out, "  {:5}  {:12.6e}", i + 1, f);
+                }
+            }
+        }
+    }
+}
+
+/// The lines `--check` adds: each reduced body's own modes ([`print_own_modes`]), the
+/// mesh's highest frequency and what the deck's step resolves of the lowest five modes,
+/// about the initial state.
 pub fn check_report(model: &Model, out: &mut dyn std::io::Write) {
     let Ok(integ) = solver::prepare(model) else {
         return;
     };
+    print_own_modes(out, &integ.sys.elements, deck_step(model));
     if integ.sys.n_node_eq > CHECK_MAX_UNKNOWNS {
         let _ = writeln!(
             out,
@@ -504,6 +554,7 @@ fn analyse_and_write(
     if !quiet {
         let mut out = std::io::stdout().lock();
         print_table(&mut out, &a, step);
+        print_own_modes(&mut out, &integ.sys.elements, step);
         let _ = writeln!(out, "written: {}", dir.display());
     }
     EXIT_OK

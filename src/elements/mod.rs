@@ -169,6 +169,25 @@ impl std::ops::AddAssign for Energies {
     }
 }
 
+/// A mesh an element draws beyond the model's nodes (a superelement's FE mesh) for
+/// ParaView: its points at the current state, their point data (global frame, SI units, as
+/// the nodes': `output::vtk`) and line cells between them (indices into `points`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ElementMesh {
+    /// Current places, m.
+    pub points: Vec<Vector3<f64>>,
+    /// Displacements from the places at rest, m.
+    pub displacement: Vec<Vector3<f64>>,
+    /// Rotation vectors (log of the rotation), rad.
+    pub rotation: Vec<Vector3<f64>>,
+    /// Velocities, m/s.
+    pub velocity: Vec<Vector3<f64>>,
+    /// Spatial angular velocities, rad/s.
+    pub angular_velocity: Vec<Vector3<f64>>,
+    /// Line cells.
+    pub lines: Vec<(usize, usize)>,
+}
+
 /// Local residual and tangent buffers of one element (sized once, reused every iteration).
 #[derive(Debug, Clone)]
 pub struct Local {
@@ -351,6 +370,20 @@ pub trait Element: Send + Sync {
 
     /// Element facts for `summary.json` (e.g. number of impacts of a contact).
     fn summary(&self) -> Option<serde_json::Value> {
+        None
+    }
+
+    /// The frequencies (Hz, ascending) of the modes the element carries as its own
+    /// coordinates — a reduced body's kept fixed-interface modes — which `--check` and
+    /// `modes` list with what the deck's step resolves of them. `None` for an element
+    /// without such modes.
+    fn own_modes_hz(&self) -> Option<Vec<f64>> {
+        None
+    }
+
+    /// The mesh the element draws at a state beyond the model's nodes (ParaView output,
+    /// `OUTPUT … VTK`): a superelement's deformed FE mesh. `None` by default.
+    fn mesh(&self, _nodes: &[NodeState]) -> Option<ElementMesh> {
         None
     }
 

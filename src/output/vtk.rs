@@ -6,7 +6,10 @@
 //! cells are the beams and the segments of rigid bodies (chains of their nodes) as
 //! `VTK_LINE` (type 3), with the element number as cell data `element`. Point data (global
 //! frame, SI units): `displacement` (m), `rotation` (rotation vector, log of the nodal
-//! rotation, rad), `velocity` (m/s), `angular_velocity` (rad/s).
+//! rotation, rad), `velocity` (m/s), `angular_velocity` (rad/s). After the nodes come the
+//! meshes elements draw ([`crate::elements::Element::mesh`]): a superelement's FE nodes,
+//! recovered from its frame and elastic coordinates, joined by the lines of its `K`'s graph,
+//! their cells numbered by the superelement.
 //!
 //! `model.pvd` is rewritten every [`PVD_EVERY`] frames and at the end, so a run that stops
 //! early leaves a readable series. No NaN or infinity is written: such a value stops the run
@@ -87,7 +90,23 @@ impl VtkWriter {
             vel.push(s.v);
             omega.push(s.r * s.w);
         }
-        let s = frame_xml(&self.cells, [&pts, &disp, &rot, &vel, &omega])?;
+        // Meshes elements draw beyond the nodes (a superelement's FE mesh), appended.
+        let mut cells = std::borrow::Cow::Borrowed(&self.cells);
+        for el in &integ.sys.elements {
+            if let Some(m) = el.mesh(&integ.nodes) {
+                let off = pts.len();
+                pts.extend(m.points);
+                disp.extend(m.displacement);
+                rot.extend(m.rotation);
+                vel.extend(m.velocity);
+                omega.extend(m.angular_velocity);
+                let id = el.id().0;
+                cells
+                    .to_mut()
+                    .extend(m.lines.iter().map(|&(a, b)| (id, off + a, off + b)));
+            }
+        }
+        let s = frame_xml(&cells, [&pts, &disp, &rot, &vel, &omega])?;
         let rel = format!("vtk/frame_{:06}.vtu", self.frames.len());
         crate::safe_file::write(&self.dir.join(&rel), s.as_bytes())?;
         self.frames.push((integ.t, rel));

@@ -19,6 +19,7 @@ pub mod fe;
 pub mod frame_model;
 pub mod invariants;
 pub mod kernel;
+pub mod mesh;
 pub mod mtx;
 pub mod origin;
 pub mod rbe;
@@ -60,6 +61,8 @@ pub struct Superelement {
     spin: spin::SpinWatch,
     /// Where its body came from (`summary.json`).
     source: cache::Source,
+    /// The FE mesh's recovery, when the deck writes VTK output.
+    shape: Option<mesh::MeshShape>,
 }
 
 impl Superelement {
@@ -71,7 +74,7 @@ impl Superelement {
         nodes: Vec<usize>,
         d: &SuperelementData,
     ) -> Result<Self, BuildError> {
-        let (body, source) = origin::body_of(model, id, &nodes, d)?;
+        let (body, shape, source) = origin::body_of(model, id, &nodes, d)?;
         let nb = d.interface.len() - 1;
         let nm = d.modal.len();
         let q_ref = nodes[1 + nb..]
@@ -86,6 +89,7 @@ impl Superelement {
             body,
             q_ref,
             source,
+            shape,
         })
     }
 
@@ -101,6 +105,7 @@ impl Superelement {
             body,
             q_ref,
             source: cache::Source::Uncached,
+            shape: None,
         }
     }
 
@@ -431,13 +436,26 @@ impl Element for Superelement {
         }
     }
 
+    fn mesh(&self, nodes: &[NodeState]) -> Option<crate::elements::ElementMesh> {
+        let shape = self.shape.as_ref()?;
+        let q = self.coordinates(nodes);
+        let qd = self.field(nodes, |s, _| s.v);
+        Some(shape.at(&nodes[self.nodes[0]], &q, &qd))
+    }
+
+    fn own_modes_hz(&self) -> Option<Vec<f64>> {
+        Some(
+            self.body
+                .omega2
+                .iter()
+                .map(|w2| w2.sqrt() / (2.0 * std::f64::consts::PI))
+                .collect(),
+        )
+    }
+
     fn summary(&self) -> Option<serde_json::Value> {
         let b = &self.body;
-        let hz: Vec<f64> = b
-            .omega2
-            .iter()
-            .map(|w2| w2.sqrt() / (2.0 * std::f64::consts::PI))
-            .collect();
+        let hz = self.own_modes_hz().unwrap_or_default();
         Some(serde_json::json!({
             "mass_kg": b.mass,
             "elastic_coordinates": b.n,

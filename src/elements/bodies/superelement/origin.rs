@@ -1,24 +1,32 @@
 //! Where a superelement's reduced body comes from: an already reduced set in its `FILES`
 //! directory ([`super::reduced`]), the reduction cache beside the FE model
 //! ([`super::cache`]), or the FE model reduced by this run ([`reduce_fe`]) and then cached.
+//! A deck that writes VTK output needs the basis over the mesh for the deformed FE mesh
+//! ([`super::mesh`]), which neither the cache nor a reduced set holds: such a run reduces
+//! (and still writes the cache), and a reduced set gives no mesh, said in a note.
 
 use super::cache::{self, Lookup, Source};
 use super::invariants::Body;
+use super::mesh::MeshShape;
 use super::{PLACE_TOL, fe, rbe, reduce, reduced};
 use crate::elements::BuildError;
 use crate::model::{ElementId, Model, SuperelementData};
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, Vector3};
+
+/// A body, its deformed mesh's recovery when the deck writes VTK, and where it came from.
+pub type Origin = (Body, Option<MeshShape>, Source);
 
 /// The body of the superelement `id` of data `d` whose model nodes are `nodes` (solver
-/// indices: the interface nodes first), and where it came from. Warnings (a cache file
-/// that is not valid) and notes (a cache that cannot be written) go to standard error;
-/// neither fails the build.
+/// indices: the interface nodes first), its mesh's recovery when the deck writes VTK, and
+/// where it came from. Warnings (a cache file that is not valid) and notes (a cache that
+/// cannot be written, a reduced set without mesh) go to standard error; none fails the
+/// build.
 pub fn body_of(
     model: &Model,
     id: ElementId,
     nodes: &[usize],
     d: &SuperelementData,
-) -> Result<(Body, Source), BuildError> {
+) -> Result<Origin, BuildError> {
     let invalid = |message: String| BuildError::Invalid {
         element: id,
         message: format!("SUPERELEMENT: {message}"),
@@ -26,16 +34,23 @@ pub fn body_of(
     let places: Vec<Vector3<f64>> = (0..d.interface.len())
         .map(|i| model.nodes[nodes[i]].position)
         .collect();
+    let what = || format!("element {} (SUPERELEMENT)", id.0);
+    let want_mesh = model.output.vtk;
     if reduced::is_set(&d.dir) {
         let body = reduced::read(&d.dir, d, &places).map_err(|e| invalid(e.to_string()))?;
-        return Ok((body, Source::Reduced(d.dir.clone())));
+        if want_mesh {
+            eprintln!(
+                "note: {}: a reduced set holds no mode shapes over the FE mesh: the VTK output has no deformed mesh of it",
+                what()
+            );
+        }
+        return Ok((body, None, Source::Reduced(d.dir.clone())));
     }
     let texts = fe::read_texts(&d.dir).map_err(|e| invalid(e.to_string()))?;
-    let what = || format!("element {} (SUPERELEMENT)", id.0);
     let entry = d.cache.then(|| cache::entry(d, &texts, &places));
-    if let Some(e) = &entry {
+    if let Some(e) = entry.as_ref().filter(|_| !want_mesh) {
         match cache::load(e) {
-            Lookup::Hit(body) => return Ok((*body, Source::Cache(e.path.clone()))),
+            Lookup::Hit(body) => return Ok((*body, None, Source::Cache(e.path.clone()))),
             Lookup::Miss => {}
             Lookup::Invalid(why) => eprintln!(
                 "warning: {}: the reduction cache {} is not valid ({why}): reduced again, and the cache rewritten",
@@ -45,7 +60,12 @@ pub fn body_of(
         }
     }
     let fe = fe::parse(&d.dir, &texts).map_err(|e| invalid(e.to_string()))?;
-    let body = reduce_fe(model, nodes, d, fe).map_err(invalid)?;
+    let (body, basis, fe) = reduce_fe(model, nodes, d, fe).map_err(invalid)?;
+    // The FE mesh for ParaView, only when the deck asks for VTK output (what a deck does
+    // not declare costs nothing: 6 basis rows per FE node).
+    let x_f = model.nodes[nodes[0]].position;
+    let shape = want_mesh.then(|| MeshShape::new(&fe, &basis, d.interface[0], x_f));
+    drop(basis);
     let source = match &entry {
         None => Source::Uncached,
         Some(e) => Source::Computed(match cache::store(e, &body) {
@@ -59,17 +79,19 @@ pub fn body_of(
             }
         }),
     };
-    Ok((body, source))
+    Ok((body, shape, source))
 }
 
 /// The FE model `fe` of the superelement reduced: its interfaces over many nodes made,
-/// its interface nodes checked at their deck places, Craig–Bampton, the invariants.
+/// its interface nodes checked at their deck places, Craig–Bampton, the invariants; with
+/// the basis `Φ` over the FE dofs and the FE model with its RBE interface nodes (what the
+/// mesh's recovery reads).
 pub fn reduce_fe(
     model: &Model,
     nodes: &[usize],
     d: &SuperelementData,
     fe: fe::FeModel,
-) -> Result<Body, String> {
+) -> Result<(Body, DMatrix<f64>, fe::FeModel), String> {
     // Interfaces over many FE nodes: their nodes at their deck nodes' places.
     let at = |a: u32| {
         let i = d.interface.iter().position(|&b| b == a).unwrap_or(0);
@@ -108,7 +130,7 @@ pub fn reduce_fe(
             ));
         }
     }
-    match tr.as_ref() {
+    let (body, basis) = match tr.as_ref() {
         // Interfaces over many nodes: the dense route on TᵀKT, TᵀMT.
         Some(_) if fe.dofs.len() > reduce::DENSE_MAX_DOFS => Err(format!(
             "RBE2/RBE3 interfaces are reduced densely, up to {} FE dofs; this model has {}",
@@ -122,8 +144,10 @@ pub fn reduce_fe(
                 .and_then(|red| {
                     Body::new(&fe, &m, &red, d.interface[0], &d.interface[1..])
                         .map_err(|e| e.to_string())
+                        .map(|b| (b, red.basis))
                 })
         }
-        None => reduce::reduce_body(&fe, &d.interface, d.modes as usize),
-    }
+        None => reduce::reduce_body_and_basis(&fe, &d.interface, d.modes as usize),
+    }?;
+    Ok((body, basis, fe))
 }

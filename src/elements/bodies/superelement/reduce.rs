@@ -33,6 +33,16 @@ pub const DENSE_UP_TO: usize = 600;
 /// dofs (or when the modes asked leave fewer than a Lanczos block of interior modes
 /// beyond them), on the sparse path above.
 pub fn reduce_body(fe: &FeModel, interface: &[u32], modes: usize) -> Result<Body, String> {
+    reduce_body_and_basis(fe, interface, modes).map(|(b, _)| b)
+}
+
+/// [`reduce_body`] and the reduction's basis `Φ` (FE dofs × elastic coordinates), which
+/// the deformed mesh's recovery needs.
+pub fn reduce_body_and_basis(
+    fe: &FeModel,
+    interface: &[u32],
+    modes: usize,
+) -> Result<(Body, DMatrix<f64>), String> {
     let n = fe.dofs.len();
     let interior = n.saturating_sub(6 * interface.len());
     let dense = n <= DENSE_UP_TO || modes + crate::lanczos::BLOCK > interior;
@@ -40,10 +50,12 @@ pub fn reduce_body(fe: &FeModel, interface: &[u32], modes: usize) -> Result<Body
     if dense && n <= DENSE_MAX_DOFS {
         let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
         let red = reduce(fe, &k, &m, interface, modes).map_err(|e| e.to_string())?;
-        Body::new(fe, &m, &red, frame, iface).map_err(|e| e.to_string())
+        let body = Body::new(fe, &m, &red, frame, iface).map_err(|e| e.to_string())?;
+        Ok((body, red.basis))
     } else {
         let red = super::sparse::reduce(fe, interface, modes).map_err(|e| e.to_string())?;
-        Body::new(fe, &fe.m, &red, frame, iface).map_err(|e| e.to_string())
+        let body = Body::new(fe, &fe.m, &red, frame, iface).map_err(|e| e.to_string())?;
+        Ok((body, red.basis))
     }
 }
 
