@@ -131,22 +131,8 @@ pub fn reduce_fe(
         }
     }
     let (body, basis) = match tr.as_ref() {
-        // Interfaces over many nodes: the dense route on TᵀKT, TᵀMT.
-        Some(_) if fe.dofs.len() > reduce::DENSE_MAX_DOFS => Err(format!(
-            "RBE2/RBE3 interfaces are reduced densely, up to {} FE dofs; this model has {}",
-            reduce::DENSE_MAX_DOFS,
-            fe.dofs.len()
-        )),
-        Some(tr) => {
-            let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
-            rbe::reduce(&fe, &k, &m, Some(tr), &d.interface, d.modes as usize)
-                .map_err(|e| e.to_string())
-                .and_then(|red| {
-                    Body::new(&fe, &m, &red, d.interface[0], &d.interface[1..])
-                        .map_err(|e| e.to_string())
-                        .map(|b| (b, red.basis))
-                })
-        }
+        // Interfaces over many nodes: the reduction on TᵀKT, TᵀMT.
+        Some(tr) => rbe::reduce_body_and_basis(&fe, tr, &d.interface, d.modes as usize),
         None => reduce::reduce_body_and_basis(&fe, &d.interface, d.modes as usize),
     }?;
     Ok((body, basis, fe))

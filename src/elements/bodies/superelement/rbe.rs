@@ -32,6 +32,7 @@
 //! (the rotation about its line is undetermined): refused.
 
 use super::fe::FeModel;
+use super::mtx::SymMatrix;
 pub use crate::model::{RbeKind, SetSpec};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
 
@@ -326,6 +327,35 @@ impl Transform {
         (&b + b.transpose()) * 0.5
     }
 
+    /// `Tᵀ A T` for a symmetric sparse `A` given by its lower triangle, as a lower
+    /// triangle (duplicates summed): the large models' route, never densified. An entry
+    /// `(i, j, v)`, `i > j`, stands for `v (e_i e_jᵀ + e_j e_iᵀ)` and adds
+    /// `v (T_iᵀ T_j + T_jᵀ T_i)`; a diagonal one `v T_iᵀ T_i` (`T_i` row `i` of `T`).
+    pub fn congruent_sparse(&self, a: &SymMatrix) -> SymMatrix {
+        let mut out = Vec::with_capacity(a.entries.len());
+        for &(i, j, v) in &a.entries {
+            for &(ca, ta) in &self.rows[i] {
+                for &(cb, tb) in &self.rows[j] {
+                    let w = v * ta * tb;
+                    if i != j {
+                        // The pair (ca, cb) of T_iᵀT_j and its transpose from T_jᵀT_i: one
+                        // lower entry, twice on the diagonal.
+                        match ca.cmp(&cb) {
+                            std::cmp::Ordering::Equal => out.push((ca, ca, 2.0 * w)),
+                            _ => out.push((ca.max(cb), ca.min(cb), w)),
+                        }
+                    } else if ca >= cb {
+                        out.push((ca, cb, w));
+                    }
+                }
+            }
+        }
+        SymMatrix {
+            n: self.len(),
+            entries: out,
+        }
+    }
+
     /// `T Φ̃`: new coordinates back to the original dofs.
     pub fn expand(&self, phi: &DMatrix<f64>) -> DMatrix<f64> {
         let mut out = DMatrix::zeros(self.rows.len(), phi.ncols());
@@ -421,6 +451,53 @@ pub fn reduce(
     };
     let mut red =
         super::reduce::reduce(&fe_t, &tr.congruent(k), &tr.congruent(m), interface, modes)?;
+    red.basis = tr.expand(&red.basis);
+    Ok(red)
+}
+
+/// The reduction with interfaces over many nodes and its inertia invariants, and the basis
+/// over `fe`'s own dofs: dense ([`reduce`]) up to [`super::reduce::DENSE_UP_TO`] FE dofs (or
+/// when the modes asked leave fewer than a Lanczos block beyond them), else sparse on
+/// `TᵀKT`, `TᵀMT` assembled sparse ([`Transform::congruent_sparse`],
+/// [`super::sparse::reduce`]), the invariants from `fe`'s own sparse `M`.
+pub fn reduce_body_and_basis(
+    fe: &FeModel,
+    tr: &Transform,
+    interface: &[u32],
+    modes: usize,
+) -> Result<(super::invariants::Body, DMatrix<f64>), String> {
+    use super::invariants::Body;
+    use super::reduce::{DENSE_MAX_DOFS, DENSE_UP_TO};
+    let n = fe.dofs.len();
+    let interior = tr.len().saturating_sub(6 * interface.len());
+    let dense = n <= DENSE_UP_TO || modes + crate::lanczos::BLOCK > interior;
+    let (frame, iface) = (interface[0], &interface[1..]);
+    if dense && n <= DENSE_MAX_DOFS {
+        let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
+        let red = reduce(fe, &k, &m, Some(tr), interface, modes).map_err(|e| e.to_string())?;
+        let body = Body::new(fe, &m, &red, frame, iface).map_err(|e| e.to_string())?;
+        Ok((body, red.basis))
+    } else {
+        let red = reduce_sparse(fe, tr, interface, modes).map_err(|e| e.to_string())?;
+        let body = Body::new(fe, &fe.m, &red, frame, iface).map_err(|e| e.to_string())?;
+        Ok((body, red.basis))
+    }
+}
+
+/// The sparse Craig–Bampton reduction on `TᵀKT`, `TᵀMT`, the basis mapped back by `T`.
+pub fn reduce_sparse(
+    fe: &FeModel,
+    tr: &Transform,
+    interface: &[u32],
+    modes: usize,
+) -> Result<super::reduce::Reduction, super::reduce::ReduceError> {
+    let fe_t = FeModel {
+        k: tr.congruent_sparse(&fe.k),
+        m: tr.congruent_sparse(&fe.m),
+        nodes: fe.nodes.clone(),
+        dofs: tr.dofs.clone(),
+    };
+    let mut red = super::sparse::reduce(&fe_t, interface, modes)?;
     red.basis = tr.expand(&red.basis);
     Ok(red)
 }

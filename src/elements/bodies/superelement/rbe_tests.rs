@@ -297,3 +297,67 @@ fn bad_sets_are_refused() {
     );
     assert_eq!(near.expect("three nodes"), vec![4, 5, 6]);
 }
+
+/// The large models' route: `TᵀAT` assembled sparse is the dense `TᵀAT` (the same sums
+/// in another order: to `n ε` of the largest entry), for rigid and averaging sets; and the
+/// sparse reduction on it gives the dense reduction's body — the bundle between two rigid
+/// plates and the L-frame with its RBE3 frame, free–free `ω²` to the two routes' errors,
+/// the Lanczos's `TOL` and round-off (as `sparse_tests`'s bound).
+#[test]
+fn the_sparse_route_with_interfaces_over_many_nodes_is_the_dense_one() {
+    let per = 6;
+    let (fe, _) = bundle(per);
+    let tip = per as u32 + 1;
+    let rigid_sets = vec![
+        rigid(
+            RbeKind::Rigid,
+            1000,
+            Vector3::zeros(),
+            (1..=4).map(|b| 100 * b + 1).collect(),
+        ),
+        rigid(
+            RbeKind::Rigid,
+            2000,
+            Vector3::x(),
+            (1..=4).map(|b| 100 * b + tip).collect(),
+        ),
+    ];
+    let (afe, avg) = averaging();
+    let cases = [
+        (fe, rigid_sets, vec![1000u32, 2000], 8usize),
+        (afe, vec![avg], vec![100u32], 8usize),
+    ];
+    for (fe, rbes, iface, modes) in cases {
+        let tr = Transform::new(&fe, &rbes, &iface).expect("transform");
+        for a in [&fe.k, &fe.m] {
+            let dense = tr.congruent(&a.to_dense());
+            let sparse = tr.congruent_sparse(a).to_dense();
+            let e = (&sparse - &dense).amax() / dense.amax();
+            assert!(e <= fe.dofs.len() as f64 * f64::EPSILON, "congruent: {e}");
+        }
+        let (k, m) = (fe.k.to_dense(), fe.m.to_dense());
+        let fe_g = rbe::with_nodes(fe.clone(), &rbes);
+        let red_d = rbe::reduce(&fe, &k, &m, Some(&tr), &iface, modes).expect("dense");
+        let red_s = rbe::reduce_sparse(&fe, &tr, &iface, modes).expect("sparse");
+        let body = |red| Body::new(&fe_g, &m, red, iface[0], &iface[1..]).expect("mass");
+        let (bd, bs) = (body(&red_d), body(&red_s));
+        let eig = |b: &Body| {
+            let (mm, kk) = b.free_free();
+            lowest_eigenvalues(&kk, &mm, &(0..mm.nrows()).collect::<Vec<_>>(), 12).expect("eig")
+        };
+        let (ed, es) = (eig(&bd), eig(&bs));
+        // κ of the transformed interior stiffness K̃_II (the interface held).
+        let kt = tr.congruent(&k);
+        let inner: Vec<usize> = (0..tr.len())
+            .filter(|&r| !iface.contains(&tr.dofs[r].0))
+            .collect();
+        let kii = DMatrix::from_fn(inner.len(), inner.len(), |a, b| kt[(inner[a], inner[b])]);
+        let kappa = scaled_condition(&kii);
+        let bound = 10.0 * (crate::lanczos::TOL + kappa * f64::EPSILON);
+        for (s, d) in es[6..].iter().zip(&ed[6..]) {
+            let e = (s - d).abs() / d;
+            eprintln!("{iface:?}: free-free ω² {d:.6e}, sparse route {e:.2e} (bound {bound:.2e})");
+            assert!(e <= bound, "{e} > {bound}");
+        }
+    }
+}
