@@ -35,6 +35,10 @@ pub struct ExportArgs {
     /// Nothing on standard output.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Write instead the reduced set of the deck's SUPERELEMENT of this number (its
+    /// reduction, as the files an already reduced SUPERELEMENT reads: docs/superelements.md).
+    #[arg(long, value_name = "ELEMENT")]
+    pub reduced: Option<u32>,
 }
 
 /// Largest number of nodal unknowns exported (the linearisation is dense).
@@ -50,6 +54,9 @@ pub fn run(args: &ExportArgs) -> u8 {
         Err(code) => return code,
     };
     let deck = args.deck.display();
+    if let Some(id) = args.reduced {
+        return export_reduced(args, &model, id);
+    }
     let integ = match crate::solver::prepare(&model) {
         Ok(i) => i,
         Err(e) => {
@@ -140,6 +147,70 @@ pub fn run(args: &ExportArgs) -> u8 {
         println!(
             "{nn} dofs on {} nodes; asymmetry of K {ak:.1e}, of M {am:.1e} (symmetrised)\nwritten: {}",
             coords.len(),
+            dir.display()
+        );
+    }
+    EXIT_OK
+}
+
+/// `mecano-rs export DECK --reduced ID`: the reduced set of SUPERELEMENT `ID`
+/// (`crate::elements::superelement::reduced`), reduced as a run would (or read from its
+/// cache).
+fn export_reduced(args: &ExportArgs, model: &crate::model::Model, id: u32) -> u8 {
+    use crate::elements::superelement::{Superelement, reduced};
+    let deck = args.deck.display();
+    let Some((el, d)) = model
+        .elements
+        .get(&crate::model::ElementId(id))
+        .and_then(|e| match &e.kind {
+            crate::model::ElementKind::Superelement(d) => Some((e, d)),
+            _ => None,
+        })
+    else {
+        eprintln!("error: {deck}: --reduced {id}: the deck has no SUPERELEMENT {id}");
+        return EXIT_BAD_INPUT;
+    };
+    let nodes: Vec<usize> = el
+        .nodes
+        .iter()
+        .map(|n| model.nodes.get_index_of(n).expect("validated model"))
+        .collect();
+    let se = match Superelement::from_model(model, el.id, nodes, d) {
+        Ok(s) => s,
+        Err(e) => {
+            let e = crate::solver::BuildError::Elements(e);
+            eprintln!(
+                "error: {}",
+                app::locate::located_model_error(&args.deck, model, &e)
+            );
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let about = format!("mecano-rs export --reduced {id} of {deck}");
+    let texts = reduced::texts(se.body(), &d.interface, &about);
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| app::default_out_dir(&args.deck, model).join("reduced"));
+    let files: Vec<String> = reduced::FILES.iter().map(|s| s.to_string()).collect();
+    let _claim = match app::outdir::OutDir::claim_fresh(&dir, &files, args.force) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {deck}: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    for (name, text) in reduced::FILES.iter().zip(&texts) {
+        if let Err(e) = crate::safe_file::write(&dir.join(name), text.as_bytes()) {
+            eprintln!("error: writing {}: {e}", dir.join(name).display());
+            return EXIT_FAILED;
+        }
+    }
+    if !args.quiet {
+        println!(
+            "SUPERELEMENT {id}: {} elastic coordinates, {} kg\nwritten: {}",
+            se.body().n,
+            se.body().mass,
             dir.display()
         );
     }

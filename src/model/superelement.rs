@@ -22,6 +22,9 @@ pub struct SuperelementData {
     /// Interfaces over many FE nodes (`RBE2`, `RBE3`), in the deck's order; each `node` is
     /// one of `interface`'s FE numbers.
     pub rbe: Vec<RbeSpec>,
+    /// `CACHE ON` (the default): the reduction is kept beside the FE files and read back
+    /// by the next run of the same inputs (`crate::elements::superelement::cache`).
+    pub cache: bool,
 }
 
 /// Which interface over many FE nodes (`crate::elements::bodies::superelement::rbe`).

@@ -48,26 +48,28 @@ fn csv_err(file: &Path, line: usize, col: usize, what: &'static str, found: &str
     }
 }
 
-/// Reads the rows of a CSV file of `header`'s columns (the header line itself checked),
-/// each field parsed by `parse`; returns (line number, fields).
-fn read_csv<T>(
-    path: &Path,
-    header: &[&str],
-    what: &'static str,
-    parse: impl Fn(&str) -> Option<T>,
-) -> Result<Vec<(usize, Vec<T>)>, MtxError> {
-    let text = mtx::read_bounded_text(path, MAX_CSV).map_err(|e| MtxError {
+/// Reads a file of the set whole (at most `max` bytes), its error located at the file.
+pub fn read_text(path: &Path, max: u64) -> Result<String, MtxError> {
+    mtx::read_bounded_text(path, max).map_err(|e| MtxError {
         file: path.to_path_buf(),
         line: 0,
         col: 0,
         kind: MtxErrorKind::Io(e),
-    })?;
+    })
+}
+
+/// Reads the rows of a CSV text (the file `path`) of `header`'s columns (the header line
+/// itself checked, `expected` its description), each field parsed by `parse`; returns (line number, fields).
+pub fn read_csv<T>(
+    path: &Path,
+    text: &str,
+    header: &[&str],
+    expected: &'static str,
+    what: &'static str,
+    parse: impl Fn(&str) -> Option<T>,
+) -> Result<Vec<(usize, Vec<T>)>, MtxError> {
     let mut rows = Vec::new();
     let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
-    let expected: &'static str = match header.len() {
-        4 => "the header `node,x,y,z`",
-        _ => "the header `dof,node,component`",
-    };
     match lines.next() {
         Some((_, h)) if h.split(',').map(str::trim).collect::<Vec<_>>().as_slice() == header => {}
         Some((_, h)) => return Err(csv_err(path, 1, 1, expected, h)),
@@ -95,10 +97,27 @@ fn read_csv<T>(
 /// Reads the four files of `dir` and checks that they agree: the matrices' size is the
 /// map's, every dof's node has coordinates, no dof is listed twice.
 pub fn read(dir: &Path) -> Result<FeModel, MtxError> {
+    parse(dir, &read_texts(dir)?)
+}
+
+/// The texts of the four files of `dir`, in [`FILES`]' order (read in the order the
+/// model is checked: `nodes.csv`, `dofs.csv`, `K.mtx`, `M.mtx`).
+pub fn read_texts(dir: &Path) -> Result<[String; 4], MtxError> {
+    let nodes = read_text(&dir.join(FILES[2]), MAX_CSV)?;
+    let dofs = read_text(&dir.join(FILES[3]), MAX_CSV)?;
+    let k = read_text(&dir.join(FILES[0]), mtx::MAX_BYTES)?;
+    let m = read_text(&dir.join(FILES[1]), mtx::MAX_BYTES)?;
+    Ok([k, m, nodes, dofs])
+}
+
+/// The FE model of the texts of `dir`'s four files ([`read_texts`]), checked as [`read`].
+pub fn parse(dir: &Path, texts: &[String; 4]) -> Result<FeModel, MtxError> {
     let p = |name: &str| -> PathBuf { dir.join(name) };
     let node_rows = read_csv(
         &p(FILES[2]),
+        &texts[2],
         &["node", "x", "y", "z"],
+        "the header `node,x,y,z`",
         "a node number and three finite coordinates",
         |s| s.parse::<f64>().ok().filter(|v| v.is_finite()),
     )?;
@@ -129,7 +148,9 @@ pub fn read(dir: &Path) -> Result<FeModel, MtxError> {
     }
     let dof_rows = read_csv(
         &p(FILES[3]),
+        &texts[3],
         &["dof", "node", "component"],
+        "the header `dof,node,component`",
         "three positive integers",
         |s| s.parse::<u64>().ok(),
     )?;
@@ -191,8 +212,16 @@ pub fn read(dir: &Path) -> Result<FeModel, MtxError> {
         }
         Ok(m)
     };
-    let k = sized(mtx::read(&p(FILES[0]))?, FILES[0])?;
-    let m = sized(mtx::read(&p(FILES[1]))?, FILES[1])?;
+    let matrix = |i: usize| {
+        mtx::parse(&texts[i]).map_err(|(line, col, kind)| MtxError {
+            file: p(FILES[i]),
+            line,
+            col,
+            kind,
+        })
+    };
+    let k = sized(matrix(0)?, FILES[0])?;
+    let m = sized(matrix(1)?, FILES[1])?;
     Ok(FeModel { k, m, nodes, dofs })
 }
 

@@ -14,16 +14,19 @@
 //! ([`kernel::residual`]) evaluated in `Dual<2>` per local direction, one part for
 //! `∂r/∂q`, one for `c_v ∂r/∂v + c_a ∂r/∂a`.
 
+pub mod cache;
 pub mod fe;
 pub mod frame_model;
 pub mod invariants;
 pub mod kernel;
 pub mod mesh;
 pub mod mtx;
+pub mod origin;
 pub mod rbe;
 #[cfg(test)]
 mod rbe_tests;
 pub mod reduce;
+pub mod reduced;
 pub mod sparse;
 #[cfg(test)]
 mod sparse_tests;
@@ -56,6 +59,8 @@ pub struct Superelement {
     q_ref: Vec<Vector3<f64>>,
     /// Its rotation against its lowest elastic frequency (`spin`).
     spin: spin::SpinWatch,
+    /// Where its body came from (`summary.json`).
+    source: cache::Source,
     /// The FE mesh's recovery, when the deck writes VTK output.
     shape: Option<mesh::MeshShape>,
 }
@@ -69,66 +74,8 @@ impl Superelement {
         nodes: Vec<usize>,
         d: &SuperelementData,
     ) -> Result<Self, BuildError> {
-        let invalid = |message: String| BuildError::Invalid {
-            element: id,
-            message: format!("SUPERELEMENT: {message}"),
-        };
-        let fe = fe::read(&d.dir).map_err(|e| invalid(e.to_string()))?;
-        // Interfaces over many FE nodes: their nodes at their deck nodes' places.
-        let at = |a: u32| {
-            let i = d.interface.iter().position(|&b| b == a).unwrap_or(0);
-            model.nodes[nodes[i]].position
-        };
-        let rbes = rbe::resolve_all(&fe, &d.rbe, at).map_err(|e| invalid(e.to_string()))?;
-        let tr = match rbes.is_empty() {
-            true => None,
-            false => Some(
-                rbe::Transform::new(&fe, &rbes, &d.interface)
-                    .map_err(|e| invalid(e.to_string()))?,
-            ),
-        };
-        let fe = rbe::with_nodes(fe, &rbes);
-        for &a in &d.interface {
-            if !fe.nodes.contains_key(&a) {
-                return Err(invalid(format!(
-                    "interface node {a}: {} has no node {a}",
-                    d.dir.join(fe::FILES[2]).display()
-                )));
-            }
-        }
+        let (body, shape, source) = origin::body_of(model, id, &nodes, d)?;
         let nb = d.interface.len() - 1;
-        // Interface places: model and FE agree relative to the frame node.
-        let size = fe
-            .nodes
-            .values()
-            .fold(0.0f64, |m, x| m.max((x - fe.nodes[&d.interface[0]]).norm()))
-            .max(1e-300);
-        let x_f = model.nodes[nodes[0]].position;
-        for (i, &a) in d.interface.iter().enumerate().skip(1) {
-            let model_rel = model.nodes[nodes[i]].position - x_f;
-            let fe_rel = fe.nodes[&a] - fe.nodes[&d.interface[0]];
-            if (model_rel - fe_rel).norm() > PLACE_TOL * size {
-                return Err(invalid(format!(
-                    "FE interface node {a} ({}) is at {:?} from the frame node in the deck but at {:?} in the FE model",
-                    model.nodes[nodes[i]].id,
-                    model_rel.as_slice(),
-                    fe_rel.as_slice()
-                )));
-            }
-        }
-        let (body, basis) = match tr.as_ref() {
-            // Interfaces over many nodes: the reduction on TᵀKT, TᵀMT.
-            Some(tr) => rbe::reduce_body_and_basis(&fe, tr, &d.interface, d.modes as usize),
-            None => reduce::reduce_body_and_basis(&fe, &d.interface, d.modes as usize),
-        }
-        .map_err(invalid)?;
-        // The FE mesh for ParaView, only when the deck asks for VTK output (what a deck
-        // does not declare costs nothing: 6 basis rows per FE node).
-        let shape = model
-            .output
-            .vtk
-            .then(|| mesh::MeshShape::new(&fe, &basis, d.interface[0], x_f));
-        drop(basis);
         let nm = d.modal.len();
         let q_ref = nodes[1 + nb..]
             .iter()
@@ -141,6 +88,7 @@ impl Superelement {
             spin: spin::SpinWatch::new(&body),
             body,
             q_ref,
+            source,
             shape,
         })
     }
@@ -156,6 +104,7 @@ impl Superelement {
             spin: spin::SpinWatch::new(&body),
             body,
             q_ref,
+            source: cache::Source::Uncached,
             shape: None,
         }
     }
@@ -163,6 +112,12 @@ impl Superelement {
     /// The reduced body.
     pub fn body(&self) -> &Body {
         &self.body
+    }
+
+    /// Where the reduced body came from: reduced (and cached or not), the cache, a
+    /// reduced set.
+    pub fn source(&self) -> &cache::Source {
+        &self.source
     }
 
     /// The elastic coordinates at a state.
@@ -506,6 +461,7 @@ impl Element for Superelement {
             "elastic_coordinates": b.n,
             "interface_nodes": self.lay.nb + 1,
             "fixed_interface_modes_hz": hz,
+            "reduction": self.source.json(),
         }))
     }
 

@@ -195,7 +195,8 @@ pub fn read(path: &Path) -> Result<SymMatrix, MtxError> {
     })
 }
 
-type Located = (usize, usize, MtxErrorKind);
+/// An error of a text: (line, column, kind).
+pub type Located = (usize, usize, MtxErrorKind);
 
 /// Column (1-based, in characters) of `field` within `line` (a sub-slice of it).
 fn col_of(line: &str, field: &str) -> usize {
@@ -203,8 +204,13 @@ fn col_of(line: &str, field: &str) -> usize {
     line[..off].chars().count() + 1
 }
 
-/// Parses a Matrix Market text; errors as (line, column, kind).
-pub fn parse(text: &str) -> Result<SymMatrix, Located> {
+/// A coordinate file's entries: rows, columns, whether `general`, and each entry's
+/// 0-based `(row, column, value, line)` in the file's order.
+type Entries = (usize, usize, bool, Vec<(usize, usize, f64, usize)>);
+
+/// Reads the banner, size line and entries of a coordinate text; `square`: a matrix of
+/// another shape is refused at its size line.
+fn entries(text: &str, square: bool) -> Result<Entries, Located> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
     let (_, banner) = lines
         .next()
@@ -249,20 +255,17 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
             ));
         }
     };
-    if rows != cols {
+    if rows != cols && (square || !general) {
         return Err((ln, 1, MtxErrorKind::NotSquare(rows, cols)));
     }
-    let n = rows;
-    let mut entries = Vec::with_capacity(nnz.min(1 << 26));
-    let mut upper = Vec::new();
-    let mut count = 0usize;
+    let mut out = Vec::with_capacity(nnz.min(1 << 26));
     for (ln, line) in lines {
-        if count == nnz {
+        if out.len() == nnz {
             let first = line.split_whitespace().next().unwrap_or(line);
             return Err((ln, col_of(line, first), MtxErrorKind::TooMany(nnz)));
         }
         let mut it = line.split_whitespace();
-        let index = |w: Option<&str>, what: &'static str| -> Result<usize, Located> {
+        let index = |w: Option<&str>, what: &'static str, n: usize| -> Result<usize, Located> {
             let w = w.ok_or((
                 ln,
                 line.chars().count() + 1,
@@ -286,8 +289,8 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
             }
             Ok(v as usize - 1)
         };
-        let i = index(it.next(), "a row index")?;
-        let j = index(it.next(), "a column index")?;
+        let i = index(it.next(), "a row index", rows)?;
+        let j = index(it.next(), "a column index", cols)?;
         let w = it.next().ok_or((
             ln,
             line.chars().count() + 1,
@@ -316,7 +319,64 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
                 MtxErrorKind::Trailing(t.chars().take(40).collect()),
             ));
         }
-        count += 1;
+        out.push((i, j, v, ln));
+    }
+    if out.len() < nnz {
+        return Err((
+            text.lines().count().max(1),
+            1,
+            MtxErrorKind::Truncated {
+                announced: nnz,
+                found: out.len(),
+            },
+        ));
+    }
+    Ok((rows, cols, general, out))
+}
+
+/// Parses a `coordinate real general` text of any shape (the reduced set's coupling
+/// matrix, `super::reduced`) into a dense matrix, duplicates summed; errors as (line,
+/// column, kind).
+pub fn parse_general(text: &str) -> Result<DMatrix<f64>, Located> {
+    let (rows, cols, general, e) = entries(text, false)?;
+    let mut a = DMatrix::zeros(rows, cols);
+    for (i, j, v, _) in e {
+        a[(i, j)] += v;
+        if !general && i != j {
+            a[(j, i)] += v;
+        }
+    }
+    Ok(a)
+}
+
+/// The `coordinate real general` text of a dense matrix of any shape (its non-zero
+/// entries, values in ryu's shortest form that reads back to the same `f64`).
+pub fn general_text(a: &DMatrix<f64>, comment: &str) -> String {
+    let nz = a.iter().filter(|v| **v != 0.0).count();
+    let mut s = String::with_capacity(32 * nz + 128);
+    s.push_str("%%MatrixMarket matrix coordinate real general\n");
+    for line in comment.lines() {
+        let _ = writeln!(s, "% {line}");
+    }
+    let _ = writeln!(s, "{} {} {nz}", a.nrows(), a.ncols());
+    let mut buf = ryu::Buffer::new();
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            let v = a[(i, j)];
+            if v != 0.0 {
+                let _ = writeln!(s, "{} {} {}", i + 1, j + 1, buf.format(v));
+            }
+        }
+    }
+    s
+}
+
+/// Parses a Matrix Market text; errors as (line, column, kind).
+pub fn parse(text: &str) -> Result<SymMatrix, Located> {
+    let (n, _, general, all) = entries(text, true)?;
+    let mut entries = Vec::with_capacity(all.len());
+    let mut upper = Vec::new();
+    for (i, j, v, ln) in all {
         if i >= j {
             entries.push((i, j, v));
         } else if general {
@@ -325,16 +385,6 @@ pub fn parse(text: &str) -> Result<SymMatrix, Located> {
             // A symmetric file that lists its upper triangle: the same matrix.
             entries.push((j, i, v));
         }
-    }
-    if count < nnz {
-        return Err((
-            text.lines().count().max(1),
-            1,
-            MtxErrorKind::Truncated {
-                announced: nnz,
-                found: count,
-            },
-        ));
     }
     let mut lower = sum_duplicates(entries);
     if general {

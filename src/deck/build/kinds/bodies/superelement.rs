@@ -1,4 +1,4 @@
-//! `SUPERELEMENT FILES <dir> MODES <n> INTERFACE <fe> <node> …`: a linear elastic body
+//! `SUPERELEMENT FILES <dir> MODES <n> INTERFACE <fe> <node> … [RBE2|RBE3 …] [CACHE ON|OFF]`: a linear elastic body
 //! reduced from an FE model (issue 38; grammar.md, "Superelements").
 
 use super::super::{Card, Parse, Parsed, row};
@@ -42,6 +42,10 @@ pub(in crate::deck::build) const CARD: Card = Card {
         row(
             "WEIGHTS",
             "SUPERELEMENT RBE3: one weight > 0 per SET node (default 1)",
+        ),
+        row(
+            "CACHE",
+            "SUPERELEMENT: CACHE ON|OFF: keep the reduction beside the FE files for the next run (default ON)",
         ),
     ],
     parse: Parse::One(parse),
@@ -97,7 +101,9 @@ fn parse(_: &mut Builder<'_>, c: &mut Cursor<'_, '_>, _: u32, _: &str) -> R<Pars
         }
         interface.push(fe);
         nodes.push(c.uint("node number (of NODES) the FE node is attached to")?);
-        if c.peek().is_none_or(|t| t.is_kw("RBE2") || t.is_kw("RBE3")) {
+        if c.peek()
+            .is_none_or(|t| t.is_kw("RBE2") || t.is_kw("RBE3") || t.is_kw("CACHE"))
+        {
             break;
         }
         if interface.len() == MAX_INTERFACE {
@@ -106,6 +112,10 @@ fn parse(_: &mut Builder<'_>, c: &mut Cursor<'_, '_>, _: u32, _: &str) -> R<Pars
         }
     }
     let rbe = rbe_clauses(c, &interface)?;
+    let cache = match c.keyword(&["CACHE"]) {
+        Some(_) => c.expect_keyword(&["ON", "OFF"], "ON or OFF after CACHE")?.0 == "ON",
+        None => true,
+    };
     c.finish()?;
     let data = SuperelementData {
         dir,
@@ -113,6 +123,7 @@ fn parse(_: &mut Builder<'_>, c: &mut Cursor<'_, '_>, _: u32, _: &str) -> R<Pars
         interface,
         modal: Vec::new(),
         rbe,
+        cache,
     };
     Ok((nodes, ElementKind::Superelement(Box::new(data))))
 }
@@ -263,5 +274,8 @@ fn write(_: &Model, e: &Element, s: &mut String) {
                 let _ = write!(s, " {w:?}");
             }
         }
+    }
+    if !d.cache {
+        let _ = write!(s, " CACHE OFF");
     }
 }
