@@ -200,6 +200,14 @@ class Deck:
             self.nodes += [(last + 1, [0, 1, 0]), (last + 2, [0.5, 1, 0]), (last + 3, [1, 1, 0])]
         if r.random() < 0.05:
             out.append(f"  FIX {r.choice(self.nodes)[0]} {r.choice(['X', 'RZ', 'ALL'])}")
+        # A superelement (issue 38): the project's exported bar (decks/superelement/beam/,
+        # FE nodes 1 at 0 and 2 at 1 m along x), copied into the case as fe/, hung from the
+        # chain's tip; its interface nodes must sit as the FE nodes do.
+        self.se = r.random() < 0.12
+        if self.se:
+            p = self.nodes[n][1]
+            out.append(f"  90 {fmt3(p)}")
+            out.append(f"  91 {fmt3([p[0] + 1.0, p[1], p[2]])}")
         # Elements.
         out.append("ELEMENTS")
         chain = [nid for nid, _ in self.nodes[: n + 1]]
@@ -252,6 +260,15 @@ class Deck:
         tip = chain[-1]
         e = self.el()
         out.append(f"  {e} MASS {tip} M {num(r, 0.01, 100)}" + (f" INERTIA {num(r, 1e-4, 1)} {num(r, 1e-4, 1)} {num(r, 1e-4, 1)}" if r.random() < 0.5 else ""))
+        if self.se:
+            e = self.el()
+            joint = r.choice(["HINGE", "SPHERICAL", "CLAMP"])
+            axis = f" AXIS {fmt3(unit(r))}" if joint == "HINGE" else ""
+            out.append(f"  {e} {joint} {tip} 90{axis}")
+            e = self.el()
+            modes = r.choice(["0", "2", "4", "6", "8", "42", "43", str(r.randrange(0, 60)), "-1"])
+            out.append(f"  {e} SUPERELEMENT FILES {r.choice(['fe', 'fe', 'fe', 'nowhere'])} MODES {modes} INTERFACE 1 90 2 91"
+                       + (f" CACHE {r.choice(['ON', 'OFF'])}" if r.random() < 0.3 else ""))
         extras = r.randrange(0, 3)
         for _ in range(extras):
             k = r.choice(["RSPRING", "CAME", "RIGID", "PRESCRIBED", "SPRING", "MASS", "SPHERICAL", "BUSHING", "CONTROL"])
@@ -584,6 +601,9 @@ def run_case(binary, root, seed, k, limit):
     sandbox = tempfile.mkdtemp(prefix=f"c{seed}_{k}_", dir=root)
     with open(os.path.join(sandbox, "deck.dat"), "w", encoding="utf-8", errors="surrogatepass") as f:
         f.write(text)
+    if "SUPERELEMENT FILES fe " in text:
+        repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        shutil.copytree(os.path.join(repo, "decks", "superelement", "beam"), os.path.join(sandbox, "fe"))
     make_decoy(sandbox)
     plants = plant(random.Random(plant_seed), sandbox)
     decoy_before = tree(os.path.join(sandbox, "decoy"))
