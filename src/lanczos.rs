@@ -186,19 +186,25 @@ pub fn largest<O: ShiftInvert>(op: &mut O, count: usize) -> Result<Eigenpairs, O
                 .into());
             }
         };
-        let big = theta.iter().any(|&x| {
-            theta
-                .iter()
-                .filter(|&&y| (x - y).abs() <= CLUSTER * x.abs())
-                .count()
-                >= block
-        });
+        let big = cluster_fills(&theta, block);
         if big && block < op.free() && block < 4 * BLOCK {
             block *= 2;
             continue;
         }
         return Ok((theta, basis));
     }
+}
+
+/// Whether a cluster of `theta` (values within [`CLUSTER`]) is as large as the block: it
+/// may hide more copies, and the block is doubled.
+pub(crate) fn cluster_fills(theta: &[f64], block: usize) -> bool {
+    theta.iter().any(|&x| {
+        theta
+            .iter()
+            .filter(|&&y| (x - y).abs() <= CLUSTER * x.abs())
+            .count()
+            >= block
+    })
 }
 
 /// Ritz values and their `M`-orthonormal vectors.

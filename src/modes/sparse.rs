@@ -54,7 +54,7 @@ use super::krylov::dot;
 use super::linearise::{self, ElementMatrices};
 use crate::elements::NodeState;
 pub use crate::lanczos::{BLOCK, ShiftInvert, TOL};
-use crate::lanczos::{CLUSTER, Outcome, iterate};
+use crate::lanczos::{Outcome, cluster_fills, iterate};
 use crate::solver::system::System;
 use nalgebra::DMatrix;
 
@@ -303,13 +303,7 @@ pub fn lowest(
             }
         };
         // A cluster of converged values as large as the block may hide more copies.
-        let big = theta.iter().any(|&x| {
-            theta
-                .iter()
-                .filter(|&&y| (x - y).abs() <= CLUSTER * x.abs())
-                .count()
-                >= block
-        });
+        let big = cluster_fills(&theta, block);
         if big && block < nn - constraints && block < 4 * BLOCK {
             block *= 2;
             continue;

@@ -254,14 +254,7 @@ pub fn reduce(
         }
         if modes > 0 {
             let (mu, y) = interior_modes(&chol, &sub(m, &interior, &interior));
-            let found = mu.iter().filter(|&&x| x > 0.0).count();
-            if found < modes {
-                return Err(ReduceError::Massless {
-                    asked: modes,
-                    found,
-                });
-            }
-            check_whole(&mu, modes)?;
+            check_kept(&mu, modes)?;
             let l = chol.l();
             for (c, (&mu_c, yc)) in mu.iter().zip(y.column_iter()).take(modes).enumerate() {
                 // φ = L⁻ᵀ y / √μ: φᵀ M_II φ = 1, φᵀ K_II φ = 1/μ = ω².
@@ -285,6 +278,19 @@ pub fn reduce(
         k: k_red,
         omega2,
     })
+}
+
+/// The `modes` largest `μ` (descending) can be kept: each has mass (`μ > 0`), and they do
+/// not end inside a multiple eigenvalue ([`check_whole`]).
+pub(super) fn check_kept(mu: &[f64], modes: usize) -> Result<(), ReduceError> {
+    let found = mu.iter().filter(|&&x| x > 0.0).count();
+    if found < modes {
+        return Err(ReduceError::Massless {
+            asked: modes,
+            found,
+        });
+    }
+    check_whole(mu, modes)
 }
 
 /// Relative difference of `μ` below which two fixed-interface modes are one multiple

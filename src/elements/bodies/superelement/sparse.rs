@@ -19,7 +19,7 @@
 
 use super::fe::FeModel;
 use super::mtx::SymMatrix;
-use super::reduce::{Partition, ReduceError, Reduction, check_whole, partition};
+use super::reduce::{Partition, ReduceError, Reduction, check_kept, partition};
 use crate::lanczos::{self, LanczosError, ShiftInvert};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::LltError;
@@ -192,14 +192,7 @@ pub fn reduce(fe: &FeModel, interface: &[u32], modes: usize) -> Result<Reduction
             let mut order: Vec<usize> = (0..theta.len()).collect();
             order.sort_by(|&a, &b| theta[b].total_cmp(&theta[a]));
             let mu: Vec<f64> = order.iter().map(|&i| theta[i]).collect();
-            let found = mu.iter().filter(|&&x| x > 0.0).count();
-            if found < modes {
-                return Err(ReduceError::Massless {
-                    asked: modes,
-                    found,
-                });
-            }
-            check_whole(&mu, modes)?;
+            check_kept(&mu, modes)?;
             for (c, &o) in order.iter().take(modes).enumerate() {
                 for (i, &r) in p.interior.iter().enumerate() {
                     basis[(r, nb + c)] = vecs[o][i];
