@@ -105,3 +105,23 @@ pub fn require_failpoints() {
         );
     }
 }
+
+/// Runs `mecano-rs <case>/d.dat -q -o <case>/out` and checks that the deck is refused as
+/// input: exit code 2, `expect` in the message, no output directory written. Returns the
+/// message, for the caller's check of where it points.
+pub fn refused(case: &std::path::Path, name: &str, expect: &str) -> String {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mecano-rs"))
+        .arg(case.join("d.dat"))
+        .args(["-q", "-o"])
+        .arg(case.join("out"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+    assert!(err.contains(expect), "{name}: `{expect}` not in: {err}");
+    assert!(
+        !case.join("out").exists(),
+        "{name}: wrote its output directory"
+    );
+    err
+}
