@@ -37,6 +37,7 @@ ROOT = bench.ROOT
 # scene -> (deck written, configuration, golden thinning, the claim's wording of the mesh)
 CONVERGED = {
     "pendulum": dict(deck="decks/pendulum_converged.dat", cfg=None, thin=2),
+    "pendulum_time": dict(deck="decks/pendulum_converged.dat", cfg=None, thin=2),
     "cantilever": dict(deck="decks/benchmarks/right_angle_cantilever_converged.dat",
                        cfg=leg(0.025, 1, 6, "ALPHA 0"), thin=1),
     "spinup": dict(deck="decks/benchmarks/spinup_converged.dat",
@@ -53,6 +54,7 @@ CONVERGED = {
 
 WHAT = {
     "pendulum": "nodes 12 and 23's positions",
+    "pendulum_time": "nodes 12 and 23's positions, against the deck's own mesh at a tenth of its step",
     "cantilever": "the elbow's and the tip's positions (nodes 2 and 3)",
     "spinup": "the tip's deflection in the rotating frame, -x sin(theta) + y cos(theta) of node 3",
     "slider_crank": "the rod's mid-span deflection (node 12 from the chord of nodes 10 and 14, on its normal)",
