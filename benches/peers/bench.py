@@ -2,7 +2,7 @@
 """Work-precision of mecano-rs and its peers on the same scenes (benches/peers/README.md).
 
     python3 benches/peers/bench.py [--out out/peers] [--scenes a,b] [--codes mecano-rs,exudyn,mbdyn]
-                                   [--rounds R] [--quick]
+                                   [--rounds R] [--quick] [--ladder PEER=N:H,...] [--append]
 
 For each scene: a converged reference (mecano-rs on a mesh and step finer than any run, with
 a second, coarser run that bounds its own error), then each code's ladder of meshes and
@@ -270,7 +270,21 @@ def main():
     ap.add_argument("--codes", default="mecano-rs,exudyn,mbdyn")
     ap.add_argument("--rounds", type=int, default=1, help="timed runs per configuration (best of)")
     ap.add_argument("--quick", action="store_true", help="only each code's cheapest two configurations")
+    ap.add_argument("--ladder", action="append", default=[], metavar="PEER=N:H,...",
+                    help="a peer's rungs instead of the scene's ladder (e.g. exudyn=80:2.5e-5,160:1e-5), run in "
+                         "OUT/<scene>/<peer>_n<N>_h<H>")
+    ap.add_argument("--append", action="store_true",
+                    help="add this sitting's records to OUT/runs.jsonl (a scene's reference once) instead of replacing it")
     a = ap.parse_args()
+    ladders = {}
+    for spec in a.ladder:
+        code, _, rungs = spec.partition("=")
+        if code not in PEERS_RUN:
+            sys.exit(f"--ladder {spec}: {code!r} is not a peer ({', '.join(PEERS_RUN)})")
+        try:
+            ladders[code] = [(int(n), float(h)) for n, h in (r.split(":") for r in rungs.split(","))]
+        except ValueError:
+            sys.exit(f"--ladder {spec}: expected PEER=N:H,N:H (elements per bar, step in s)")
     os.makedirs(a.out, exist_ok=True)
     status = peer_status(a.out)
     codes = a.codes.split(",")
@@ -307,14 +321,14 @@ def main():
                 records.append(dict(code=code, scene=scene, ok=False, why=status[code], label="-"))
                 print(f"[{scene}] {code}: {status[code]}", flush=True)
                 continue
-            ladder = sc.get(code.replace("-rs", ""), [])
+            ladder = ladders.get(code) or sc.get(code.replace("-rs", ""), [])
             if not ladder and code != "mecano-rs":
                 records.append(dict(code=code, scene=scene, ok=False, label="-", why="scene not modelled for this code"))
                 continue
             if a.quick:
                 ladder = ladder[:2]
             for i, cfg in enumerate(ladder):
-                d = os.path.join(sd, f"{code}_{i}")
+                d = os.path.join(sd, f"{code}_n{cfg[0]}_h{cfg[1]:g}" if code in ladders else f"{code}_{i}")
                 best = None
                 for _ in range(a.rounds):
                     if code == "mecano-rs":
@@ -334,11 +348,16 @@ def main():
                 msg = (f"error {r['error']:.2e}, cpu {r['cpu']:.3f} s, {r['steps']} steps, {r['newton']} Newton"
                        if r["ok"] else f"FAILED: {r.get('why')}")
                 print(f"[{scene}] {code} {r['label']}: {msg}", flush=True)
-    tmp = os.path.join(a.out, "runs.jsonl.tmp")
+    runs = os.path.join(a.out, "runs.jsonl")
+    if a.append and os.path.exists(runs):
+        old = [json.loads(line) for line in open(runs)]
+        have = {json.dumps(r, sort_keys=True) for r in old if r["code"] == "reference"}
+        records = old + [r for r in records if json.dumps(r, sort_keys=True) not in have]
+    tmp = os.path.join(a.out, f"runs.jsonl.tmp{os.getpid()}")
     with open(tmp, "w") as f:
         for r in records:
             f.write(json.dumps(r) + "\n")
-    os.replace(tmp, os.path.join(a.out, "runs.jsonl"))   # nothing half-written
+    os.replace(tmp, runs)   # nothing half-written
     import tables
     tables.report(records, a.out)
 
