@@ -18,7 +18,7 @@
 //! iteration matrix).
 //!
 //! Newton is *modified* (the matrix is kept, also from one step to the next of the same
-//! size, while each iteration divides the residual by at least 1/[`CONTRACTION`] = 4; then only
+//! size, while each iteration divides the residual by at least 1/[`CONTRACTION`] = 2; then only
 //! residuals are assembled, which for the beams skips the dual-number tangent, and the LU
 //! is reused), and an iterate reached with a kept matrix is polished until the residual
 //! stagnates, so the converged states equal full Newton's (1.5e-8 m on the rigid pendulum
@@ -39,7 +39,17 @@ pub const CONSTRAINT_TOL: f64 = 1e-11;
 
 /// Modified Newton keeps its iteration matrix while each iteration divides the relative
 /// residual by at least 1/CONTRACTION.
-pub const CONTRACTION: f64 = 0.25;
+///
+/// ½, the ESDIRK stages' [`STAGE_CONTRACTION`], since issue 37 (item 4): a rebuild (the
+/// beams' tangent and an LU) costs 10–15 iterations (a residual and a solve) on beams of
+/// order 3–5, and a matrix kept from the last step typically contracts by 3e-3 at its first
+/// iteration and by 0.3–0.5 at its second; at ¼ the cantilever of order 5 per leg (HHT,
+/// h = 0.025 s) rebuilt 848 times in 1,200 steps, at ½ 577 (+33 % iterations), 7–8 % less
+/// CPU; the seed's pendulum (two-node beams) 5,651 → 2,777 rebuilds, 1.6 % less; the spin-up,
+/// the four-bar and the clearance slider-crank unchanged within 1 % (docs/performance.md,
+/// "Where the CPU goes"). Going to 0.7–0.9, or a cost model (keep while the iterations the
+/// measured rate still needs are fewer than a rebuild's cost), gave nothing more.
+pub const CONTRACTION: f64 = 0.5;
 
 /// [`CONTRACTION`] for the stages of the ESDIRK schemes (`newton.rs`).
 pub const STAGE_CONTRACTION: f64 = 0.5;

@@ -228,7 +228,9 @@ impl Integrator {
         // step moves the state 5–25 HHT steps' worth, so the joints' rows of a matrix kept
         // from an earlier step converge linearly at ~0.1–0.5 while the node rows converge at
         // ~1e-3; rebuilding at 1/4 cost ESDIRK5 1.29 factorisations per step on flexible1 at
-        // H = 3.90625e-4 s, at 1/2 0.83, for 11 % more iterations and ~8 % less CPU.
+        // H = 3.90625e-4 s, at 1/2 0.83, for 11 % more iterations and ~8 % less CPU. HHT and
+        // generalized-α keep theirs down to 1/2 too (`CONTRACTION`: measured on the beam
+        // benchmarks, issue 37); the two constants stay apart so that either can be tuned.
         let contraction = match kin {
             Kinematics::Hht => CONTRACTION,
             Kinematics::Stage => STAGE_CONTRACTION,
