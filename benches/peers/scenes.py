@@ -134,8 +134,10 @@ SCENES = {
         nodes=[3], widths=[1], channels=spinup_v,
         ref=mk("reference: 4 x order 8, ESDIRK5, h = 2.5e-3", 2.5e-3, 4, 8, "ESDIRK5"),
         check=mk("check: 2 x order 8, ESDIRK5, h = 5e-3", 5e-3, 2, 8, "ESDIRK5"),
-        # (ESDIRK5 here: 7 factorisations a step, where the pendulum needs 1.3; 1 x order 6 at
-        # h = 0.02, which an older note said stopped at t = 0, runs: 3.3e-4 in 0.66 s)
+        # (ESDIRK5 here: 7 factorisations a step at h = 0.02, 19 at 0.04, where the pendulum
+        # needs 1.3: Newton leaves its region when the beam turns 0.16 rad a step, HHT too;
+        # docs/performance.md, "The spin-up with ESDIRK5". 1 x order 6 at h = 0.02, which an
+        # older note said stopped at t = 0, runs: 3.3e-4 in 0.66 s)
         mecano=[mk("the deck: 10 two-node, HHT -0.05, h = 0.01", 0.01, 10, 1, "ALPHA -0.05"),
                 mk(None, 0.005, 10, 1, "ALPHA -0.05"),
                 mk(None, 0.01, 20, 1, "ALPHA -0.05"),

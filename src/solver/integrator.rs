@@ -18,7 +18,7 @@
 //! iteration matrix).
 //!
 //! Newton is *modified* (the matrix is kept, also from one step to the next of the same
-//! size, while each iteration divides the residual by at least 1/[`CONTRACTION`] = 4; then only
+//! size, while each iteration divides the residual by at least 1/[`CONTRACTION`] ≈ 2.9; then only
 //! residuals are assembled, which for the beams skips the dual-number tangent, and the LU
 //! is reused), and an iterate reached with a kept matrix is polished until the residual
 //! stagnates, so the converged states equal full Newton's (1.5e-8 m on the rigid pendulum
@@ -39,7 +39,21 @@ pub const CONSTRAINT_TOL: f64 = 1e-11;
 
 /// Modified Newton keeps its iteration matrix while each iteration divides the relative
 /// residual by at least 1/CONTRACTION.
-pub const CONTRACTION: f64 = 0.25;
+///
+/// 0.35 since issue 37 (item 4; ¼ before), measured on the beam benchmarks: a rebuild (the
+/// beams' tangent and an LU) costs 10–15 iterations (a residual and a solve) on beams of
+/// order 3–5, and a matrix kept from the last step typically contracts by ~3e-3 at its first
+/// iteration and by 0.3–0.5 at its second. The cantilever of order 5 per leg (HHT,
+/// h = 0.025 s) rebuilt 848 times in 1,200 steps at ¼, 709 at 0.35, 577 at ½; the seed's
+/// pendulum 5,651, 4,226, 2,777. ½ (the stages' [`STAGE_CONTRACTION`]) was 7–8 % faster on
+/// the cantilever but left the polished iterate of the stiff-bar pendulum 2.8e-8 m from
+/// Newton at round-off tolerances after 0.3 s (¼: 1.7e-9 m; 0.4: 1.3e-8 m; 0.35: 5.2e-9 m),
+/// past `tests/accuracy.rs`'s bound of a tenth of the time error (1.7e-8 m): a slower
+/// contraction leaves more of the error in the mechanism's directions, which stiff bars'
+/// residuals do not show. 0.7–0.9, or a cost model (keep while the iterations the measured
+/// rate still needs are fewer than a rebuild's cost), gained no more than ½ did
+/// (docs/performance.md, "Where the CPU goes").
+pub const CONTRACTION: f64 = 0.35;
 
 /// [`CONTRACTION`] for the stages of the ESDIRK schemes (`newton.rs`).
 pub const STAGE_CONTRACTION: f64 = 0.5;
