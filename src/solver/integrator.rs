@@ -174,8 +174,8 @@ pub struct Integrator {
     pub step_cap: f64,
     /// Adaptive time stepping (local error tolerances), `None` = fixed steps.
     pub adaptive: Option<crate::model::Adaptive>,
-    /// The run's length, s (its `END`): adaptive ESDIRK steps are allowed the tolerance in
-    /// proportion to their share of it (error per unit step, [`Self::embedded_error`]).
+    /// The run's length, s (its `END`): an adaptive ESDIRK step's velocity error counts as
+    /// displacing the positions for this long (`T |e_v|`, [`Self::embedded_error`]).
     pub error_horizon: f64,
     /// Step the local error estimate proposes after the last accepted step (adaptive).
     pub error_next: f64,
