@@ -40,7 +40,6 @@ pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// energy created above its ceiling at the smallest step.)
 pub const FORMAT_VERSION: u32 = 5;
 const MAGIC: &[u8; 8] = b"MECANOCK";
-const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 
 /// The deck a run belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -115,13 +114,7 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 /// What `checkpoint.bin` holds: header and payload.
 fn encode(c: &Checkpoint) -> io::Result<Vec<u8>> {
     let payload = postcard::to_stdvec(c).map_err(io::Error::other)?;
-    let mut out = Vec::with_capacity(HEADER_LEN + payload.len());
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&Sha256::digest(&payload));
-    out.extend_from_slice(&payload);
-    Ok(out)
+    Ok(crate::framed::frame(MAGIC, FORMAT_VERSION, &payload))
 }
 
 fn decode(path: &Path, bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
@@ -129,28 +122,7 @@ fn decode(path: &Path, bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
         path: path.to_path_buf(),
         why,
     };
-    if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
-        return Err(invalid("it does not begin with `MECANOCK`".into()));
-    }
-    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if version != FORMAT_VERSION {
-        return Err(invalid(format!(
-            "format version {version}, this mecano-rs reads version {FORMAT_VERSION}"
-        )));
-    }
-    let len = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
-    let payload = &bytes[HEADER_LEN..];
-    if payload.len() as u64 != len {
-        return Err(invalid(format!(
-            "{} bytes of payload, the header says {len} (a torn write?)",
-            payload.len()
-        )));
-    }
-    if Sha256::digest(payload)[..] != bytes[20..52] {
-        return Err(invalid(
-            "its checksum does not match (a damaged file?)".into(),
-        ));
-    }
+    let payload = crate::framed::unframe(bytes, MAGIC, FORMAT_VERSION).map_err(invalid)?;
     postcard::from_bytes(payload).map_err(|e| invalid(format!("cannot decode it: {e}")))
 }
 

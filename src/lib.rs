@@ -15,6 +15,7 @@ pub mod dual;
 pub mod elements;
 pub mod failpoint;
 pub mod figure;
+pub mod framed;
 pub mod interrupt;
 pub mod interval;
 mod kinds;

@@ -43,7 +43,6 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Version of the cache's format; a file of another version is ignored (and rewritten).
 pub const FORMAT_VERSION: u32 = 1;
 const MAGIC: &[u8; 8] = b"MECANOSE";
-const HEADER_LEN: usize = 8 + 4 + 8 + 32;
 /// The cache's directory, inside the superelement's `FILES` directory.
 pub const DIR_NAME: &str = ".mecano-cache";
 /// Largest cache file read (a body of 2,000 elastic coordinates is ~1 GB).
@@ -213,37 +212,12 @@ pub fn encode(key: [u8; 32], body: &Body) -> Vec<u8> {
         omega2: body.omega2.clone(),
     };
     let payload = postcard::to_stdvec(&stored).expect("plain data encodes");
-    let mut out = Vec::with_capacity(HEADER_LEN + payload.len());
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&Sha256::digest(&payload));
-    out.extend_from_slice(&payload);
-    out
+    crate::framed::frame(MAGIC, FORMAT_VERSION, &payload)
 }
 
 /// The key and body of a cache file's bytes, or why they are not one.
 pub fn decode(bytes: &[u8]) -> Result<([u8; 32], Body), String> {
-    if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
-        return Err("it does not begin with `MECANOSE`".into());
-    }
-    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if version != FORMAT_VERSION {
-        return Err(format!(
-            "format version {version}, this mecano-rs reads version {FORMAT_VERSION}"
-        ));
-    }
-    let len = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
-    let payload = &bytes[HEADER_LEN..];
-    if payload.len() as u64 != len {
-        return Err(format!(
-            "{} bytes of payload, the header says {len} (a torn write?)",
-            payload.len()
-        ));
-    }
-    if Sha256::digest(payload)[..] != bytes[20..52] {
-        return Err("its checksum does not match (a damaged file?)".into());
-    }
+    let payload = crate::framed::unframe(bytes, MAGIC, FORMAT_VERSION)?;
     let s: Stored = postcard::from_bytes(payload).map_err(|e| format!("cannot decode it: {e}"))?;
     let n = usize::try_from(s.n).map_err(|_| "its size does not fit".to_string())?;
     let fits = n < 1 << 20
