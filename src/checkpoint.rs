@@ -37,8 +37,9 @@ pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// energy guard's record, and the step controller its regrowth after a landing, and the
 /// stage schemes' index-1 reaction solve's factors; 4: the guard's record holds the largest
 /// energies of the oscillations, since its running minimum and over the run; 5: and the
-/// energy created above its ceiling at the smallest step.)
-pub const FORMAT_VERSION: u32 = 5;
+/// energy created above its ceiling at the smallest step; 6: the nodes' orientations at the
+/// kept factorisation, whose co-rotated frames the next solve uses.)
+pub const FORMAT_VERSION: u32 = 6;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 
 /// The deck a run belongs to.

@@ -148,14 +148,19 @@ fn modified_newton_is_as_accurate_as_full_newton() {
         );
         // The factorisations are refactorisations on kept pivots (src/solver/linear.rs)
         // except where a kept pivot fails its threshold test: 2–4 pivot searches in
-        // 424–9,001 factorisations here (two at the start). 1 % guards that the cheap path
-        // is the one taken; the round-off run above is the check of its accuracy.
+        // 304–9,001 factorisations here (two at the start, whatever the run's length; since
+        // the kept matrix turns with the beams, modified Newton factors only ~300 times in
+        // 0.3 s). At most those 4 and 1 % of the rest guards that the cheap path is the one
+        // taken; the round-off run above is the check of its accuracy.
         for s in [&s_exact, &s_mod, &s_full] {
             eprintln!(
                 "  pivot searches {} of {} factorisations",
                 s.pivot_searches, s.factorizations
             );
-            assert!(100 * s.pivot_searches <= s.factorizations, "{name}: {s:?}");
+            assert!(
+                100 * s.pivot_searches.saturating_sub(4) <= s.factorizations,
+                "{name}: {s:?}"
+            );
         }
         assert!(
             gap_mod <= 0.1 * discretisation,

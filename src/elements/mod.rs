@@ -405,6 +405,15 @@ pub trait Element: Send + Sync {
         false
     }
 
+    /// Whether the element's forces on its nodes' translations turn with the nodes' frames
+    /// and its moments are material: `f_x(Qx, QR) = Q f_x(x, R)`, `m(Qx, QR) = m(x, R)` for
+    /// a rigid turn `Q` of its nodes (a deformable body: beams). Modified Newton applies a
+    /// kept matrix in such nodes' co-rotated frames (`solver/integrator/corotated.rs`).
+    /// Default: no (a joint's rows and a rigid body's are exact in the global frame).
+    fn turns_with_its_nodes(&self) -> bool {
+        false
+    }
+
     /// Whether a constraint of the element depends on time (a driver). Default: no.
     fn rheonomic(&self) -> bool {
         false

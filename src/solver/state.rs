@@ -97,6 +97,8 @@ pub struct IntegratorState {
     error_next: f64,
     event_floor: f64,
     lu_step: f64,
+    /// The nodes' orientations the kept LU was computed at (`Integrator::lu_frames`).
+    lu_frames: Vec<[f64; 9]>,
     trial: Vec<NodeRec>,
     trial_pseudo: Vec<Pair>,
     trial_lambda: Vec<f64>,
@@ -175,6 +177,7 @@ impl Integrator {
             error_next: self.error_next,
             event_floor: self.event_floor,
             lu_step: self.lu_step,
+            lu_frames: self.lu_frames.iter().map(arr9).collect(),
             trial: self.trial.iter().map(NodeRec::from).collect(),
             trial_pseudo: pairs(&self.trial_pseudo),
             trial_lambda: self.trial_lambda.clone(),
@@ -209,6 +212,7 @@ impl Integrator {
             ("trial pseudo-accelerations", s.trial_pseudo.len(), nn),
             ("increments", s.u.len(), nn),
             ("tangent maps", s.tmap.len(), nn),
+            ("factorisation frames", s.lu_frames.len(), nn),
             ("equations", s.lambda.len(), n),
             ("trial multipliers", s.trial_lambda.len(), n),
             ("Newton corrections", s.delta.len(), n),
@@ -241,6 +245,9 @@ impl Integrator {
         restore_pairs(&mut self.trial_pseudo, &s.trial_pseudo);
         restore_pairs(&mut self.u, &s.u);
         for (d, m) in self.tmap.iter_mut().zip(&s.tmap) {
+            *d = Matrix3::from_column_slice(m);
+        }
+        for (d, m) in self.lu_frames.iter_mut().zip(&s.lu_frames) {
             *d = Matrix3::from_column_slice(m);
         }
         self.lambda = s.lambda;

@@ -118,6 +118,7 @@ impl Integrator {
             return true;
         }
         self.lu_step = h;
+        self.keep_frames();
         match self.descent(nn) {
             Some((along, r, d)) => along < -1e-12 * r * d,
             None => true,

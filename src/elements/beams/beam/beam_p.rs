@@ -470,6 +470,10 @@ impl Element for BeamP {
         &self.nodes
     }
 
+    fn turns_with_its_nodes(&self) -> bool {
+        true
+    }
+
     fn evaluate(
         &self,
         ctx: &EvalContext,

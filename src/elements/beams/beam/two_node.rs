@@ -224,6 +224,10 @@ impl Element for Beam {
         &self.nodes
     }
 
+    fn turns_with_its_nodes(&self) -> bool {
+        true
+    }
+
     fn evaluate(
         &self,
         ctx: &EvalContext,
