@@ -103,17 +103,43 @@ fn null_vector(a: &Matrix3<f64>, lam: Complex<f64>) -> Vector3<Complex<f64>> {
     }
 }
 
-/// The grid of `Ω` the supremum is taken on: 2001 points, geometric from 1e-4 to π
-/// (the rise is `O(Ω²)` below; the grid's relative spacing 0.46 % moves a smooth maximum
-/// by `O(1e-5)` of itself).
-pub fn grid() -> impl Iterator<Item = f64> {
-    let n = 2000;
-    (0..=n).map(move |k| PI * 10f64.powf(-4.0 * (1.0 - k as f64 / n as f64)))
+/// Points of the grid of `Ω` the supremum is taken on, less one.
+const GRID: usize = 2000;
+/// Every `COARSE`-th point of the grid is searched first ([`run_bound`]).
+const COARSE: usize = 10;
+
+/// Point `k` of the grid of `Ω` the supremum is taken on: 2001 points, geometric from 1e-4
+/// to π (the rise is `O(Ω²)` below; the grid's relative spacing 0.46 % moves a smooth
+/// maximum by `O(1e-5)` of itself).
+fn grid_point(k: usize) -> f64 {
+    PI * 10f64.powf(-4.0 * (1.0 - k as f64 / GRID as f64))
 }
 
-/// `g` of the module docs for an α scheme: `sup_{Ω ≤ π} (r(Ω) − 1)`.
+/// The grid of `Ω` the supremum is taken on ([`grid_point`]).
+pub fn grid() -> impl Iterator<Item = f64> {
+    (0..=GRID).map(grid_point)
+}
+
+/// `g` of the module docs for an α scheme: `sup_{Ω ≤ π} (r(Ω) − 1)` on the grid. The rise
+/// is a smooth function of `Ω` with a single maximum (interior or at π), so the grid's
+/// largest value lies between the neighbours of the largest of every tenth point: those
+/// 201 points, then the 18 grid points between the neighbours, give the same value as the
+/// 2001 (a test compares the two over the α family) in a ninth of the time — 2.4 ms of
+/// every run's start on this machine (each point is a 3 × 3 eigenproblem).
 pub fn run_bound(p: &AlphaParams) -> f64 {
-    grid().map(|om| orbit_rise(p, om)).fold(0.0, f64::max)
+    let (mut best, mut at) = (0.0f64, 0);
+    for k in (0..=GRID).step_by(COARSE) {
+        let r = orbit_rise(p, grid_point(k));
+        if r > best {
+            (best, at) = (r, k);
+        }
+    }
+    let lo = at.saturating_sub(COARSE - 1);
+    let hi = (at + COARSE - 1).min(GRID);
+    (lo..=hi)
+        .filter(|k| k % COARSE != 0)
+        .map(|k| orbit_rise(p, grid_point(k)))
+        .fold(best, f64::max)
 }
 
 #[cfg(test)]
@@ -184,6 +210,19 @@ mod tests {
         }
         let trap = AlphaParams::new(0.0);
         assert!(run_bound(&trap) < 1e-10, "{}", run_bound(&trap));
+    }
+
+    /// The coarse-then-fine search of [`run_bound`] finds the largest value of the whole
+    /// grid, bit for bit, over the α family: HHT α from −1/3 to 0 and generalized-α ρ∞ from
+    /// 0 to 1.
+    #[test]
+    fn the_coarse_then_fine_search_finds_the_grids_largest_value() {
+        let hht = (0..=40).map(|i| AlphaParams::new(-f64::from(i) / 120.0));
+        let galpha = (0..=40).map(|i| AlphaParams::generalized(f64::from(i) / 40.0));
+        for p in hht.chain(galpha) {
+            let whole = grid().map(|om| orbit_rise(&p, om)).fold(0.0, f64::max);
+            assert_eq!(run_bound(&p), whole, "{p:?}");
+        }
     }
 
     /// The values docs/stability.md quotes (HHT α = −0.1, −0.05, −1/3; generalized-α
