@@ -76,7 +76,7 @@ impl Integrator {
 
 #[cfg(test)]
 mod tests {
-    use crate::elements::NodeState;
+    use crate::elements::testing;
     use crate::rotation;
     use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -124,41 +124,11 @@ END
         let mut integ = crate::solver::prepare(&model).expect("builds");
         integ.initialize().expect("starts");
         assert!(integ.turning.iter().all(|&t| t));
-        let mut g = 987u64;
-        let mut rnd = move || {
-            g = g
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (g >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        // A deformed, moving state A (strains ~1e-3, rotations up to ~1.5 rad).
-        let a: Vec<NodeState> = integ
-            .sys
-            .x0
-            .iter()
-            .map(|x0| {
-                let mut v = || Vector3::new(rnd(), rnd(), rnd());
-                NodeState {
-                    x: x0 + v() * 1e-3,
-                    r: rotation::exp(&(v() * 0.2)) * rotation::exp(&Vector3::new(0.0, 0.0, 1.5)),
-                    v: v(),
-                    w: v(),
-                    a: v(),
-                    wd: v(),
-                }
-            })
-            .collect();
+        // A deformed, moving state A (strains ~1e-3, rotations up to ~1.5 rad), and B, A
+        // turned rigidly by 2.6 rad.
+        let a = testing::random_states(&integ.sys.x0, 1e-3, 1.5, 987);
         let q = rotation::exp(&Vector3::new(0.4, -1.3, 2.2));
-        let b: Vec<NodeState> = a
-            .iter()
-            .map(|s| NodeState {
-                x: q * s.x,
-                r: q * s.r,
-                v: q * s.v,
-                a: q * s.a,
-                ..*s
-            })
-            .collect();
+        let b = testing::rigidly_moved(&a, &q, &Vector3::zeros());
         let ctx = integ.context(0.0, 1e-3, integ.scale);
         let lambda = vec![0.0; integ.sys.n_eq()];
         integ.sys.assemble_with(&ctx, &a, &lambda, true, None);
