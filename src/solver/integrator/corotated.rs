@@ -18,10 +18,11 @@
 //! they are; a kept matrix that no longer contracts is rebuilt as before (`newton.rs`), so
 //! this changes how long a matrix is kept, never what a converged iterate must satisfy.
 //!
-//! (Crisfield's co-rotational beams rotate the element's matrix the same way, element by
-//! element; Crisfield, *Non-linear Finite Element Analysis of Solids and Structures*, vol. 2,
-//! § 17.2. Here the rotation is applied to the factored global matrix through its right-hand
-//! side and solution, which costs a 3 × 3 product per node and solve.)
+//! (Co-rotational beam elements rotate each element's matrix from a frame that follows the
+//! element in the same way: Crisfield, *Non-linear Finite Element Analysis of Solids and
+//! Structures*, vol. 2, Wiley 1997, on the co-rotational formulation. Here the identity
+//! `S = D S_f Dᵀ` above is used on the factored global matrix, through its right-hand side and
+//! solution, which costs a 3 × 3 product per node and solve.)
 
 use super::Integrator;
 use crate::solver::system::{FIXED, System};
