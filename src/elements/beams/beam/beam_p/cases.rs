@@ -5,7 +5,9 @@
 
 use super::*;
 use crate::elements::testing::static_ctx;
+use crate::elements::{Element, EvalContext};
 use crate::rotation;
+use crate::rotation::skew;
 use nalgebra::{DMatrix, DVector};
 
 /// Steel of the seed (E = 2.1e11, ν = 0.3, ρ = 7800; κ = 5/6) on the seed's section

@@ -3,6 +3,7 @@
 
 use super::super::two_node::{Beam, default_axis2, reference_triad};
 use super::*;
+use crate::elements::Element;
 use crate::elements::testing::*;
 use crate::rotation;
 
