@@ -239,28 +239,31 @@ pub const CHECK_MAX_UNKNOWNS: usize = 1500;
 /// The rigid modes and the lowest `elastic` others about the initial state (fewer when the
 /// model has fewer). One dense solve in the usual case (room for six rigid motions); a
 /// model with fewer free unknowns or more rigid motions takes a second one, sized by the
-/// first. `warn`: as [`reach_state`]'s.
+/// first. `warn`: as [`reach_state`]'s. The frequencies alone: the modes carry no shapes
+/// ([`Solver::DenseFrequencies`]).
 pub fn lowest_about_initial(
     model: &Model,
     elastic: usize,
     warn: bool,
 ) -> Result<ModalAnalysis, Failed> {
+    // Its callers (a run's summary, `--check`, `study`) print frequencies: no shapes.
+    const SOLVER: Solver = Solver::DenseFrequencies;
     let guess = elastic + 6;
-    let probe = match analyse_model_with(model, About::Initial, guess, warn, Solver::Dense) {
+    let probe = match analyse_model_with(model, About::Initial, guess, warn, SOLVER) {
         Ok((_, mut a)) if a.rigid_modes + elastic <= guess => {
             // Rigid modes come first, then the others by frequency.
             a.modes.truncate(a.rigid_modes + elastic);
             return Ok(a);
         }
         Ok((_, a)) => a,
-        Err(_) => analyse_model_with(model, About::Initial, 1, warn, Solver::Dense)?.1,
+        Err(_) => analyse_model_with(model, About::Initial, 1, warn, SOLVER)?.1,
     };
     // A state-space solve (gyroscopic, damped) finds up to twice the free unknowns'
     // eigenvalues; at most `free_unknowns` modes may be asked for.
     let n = (probe.rigid_modes + elastic)
         .min(probe.finite_modes)
         .min(probe.free_unknowns);
-    Ok(analyse_model_with(model, About::Initial, n, warn, Solver::Dense)?.1)
+    Ok(analyse_model_with(model, About::Initial, n, warn, SOLVER)?.1)
 }
 
 /// How far the state a modal analysis linearises about is from a static equilibrium:

@@ -201,13 +201,13 @@ fn eigen_unblocked(a: &Mat<f64>) -> Option<(Vec<faer::c64>, Mat<faer::c64>)> {
     Some((s, u))
 }
 
-/// The reduced damped or gyroscopic problem's modes (first-order form), one per conjugate
-/// pair (and one per real eigenvalue), sorted by `|s|`.
-pub fn state_space(
+/// The first-order form's matrix `A = [0 I; −K̂ −Ĉ]` in mass-orthonormal coordinates and
+/// `L⁻¹` (`M = LLᵀ`).
+fn first_order(
     k: &DMatrix<f64>,
     c: &DMatrix<f64>,
     m: &DMatrix<f64>,
-) -> Result<Vec<RawMode>, DenseError> {
+) -> Result<(Mat<f64>, DMatrix<f64>), DenseError> {
     let n = k.nrows();
     let chol = m.clone().cholesky().ok_or(DenseError::MasslessDamped)?;
     // In the mass-orthonormal coordinates `u = Lᵀy` (`M = LLᵀ`) the matrices are
@@ -229,6 +229,60 @@ pub fn state_space(
         (false, true) => -mk[(i - n, j)],
         (false, false) => -mc[(i - n, j - n)],
     });
+    Ok((a, linv))
+}
+
+/// `ω²` of a first-order eigenvalue: `|s|²`, negative for a growing real root.
+fn omega2_of(z: faer::c64) -> f64 {
+    (z.re * z.re + z.im * z.im) * if z.re > 0.0 { -1.0 } else { 1.0 }
+}
+
+/// [`eigen_unblocked`]'s eigenvalues alone (the same Francis QR on the Hessenberg form,
+/// without accumulating the Schur vectors or solving for the eigenvectors).
+fn eigenvalues_unblocked(a: &Mat<f64>) -> Option<Vec<faer::c64>> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{ComputeEigenvectors, EvdParams, evd_real, evd_scratch};
+    if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+        return None;
+    }
+    let n = a.nrows();
+    let mut params: faer::Spec<EvdParams, f64> =
+        faer::Spec::new(<EvdParams as faer::Auto<f64>>::auto());
+    params.config.schur.blocking_threshold = usize::MAX;
+    let par = faer::Par::Seq;
+    let mut s_re = faer::diag::Diag::<f64>::zeros(n);
+    let mut s_im = faer::diag::Diag::<f64>::zeros(n);
+    let mut buf = MemBuffer::new(evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::No,
+        par,
+        params,
+    ));
+    evd_real(
+        a.as_ref(),
+        s_re.as_mut(),
+        s_im.as_mut(),
+        None,
+        None,
+        par,
+        MemStack::new(&mut buf),
+        params,
+    )
+    .ok()?;
+    let (re, im) = (s_re.column_vector(), s_im.column_vector());
+    Some((0..n).map(|j| faer::c64::new(re[j], im[j])).collect())
+}
+
+/// The reduced damped or gyroscopic problem's modes (first-order form), one per conjugate
+/// pair (and one per real eigenvalue), sorted by `|s|`.
+pub fn state_space(
+    k: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+) -> Result<Vec<RawMode>, DenseError> {
+    let n = k.nrows();
+    let (a, linv) = first_order(k, c, m)?;
     let (s, u) = eigen_unblocked(&a).ok_or(DenseError::NoConvergence)?;
     let mut out = Vec::new();
     for i in 0..2 * n {
@@ -254,15 +308,36 @@ pub fn state_space(
         };
         let u = DVector::from_fn(n, |r, _| col(r).re * rot.0 - col(r).im * rot.1);
         let shape = linv.transpose() * u;
-        let omega2 = (z.re * z.re + z.im * z.im) * if z.re > 0.0 { -1.0 } else { 1.0 };
         out.push(RawMode {
             s: (z.re, z.im),
-            omega2,
+            omega2: omega2_of(z),
             shape,
         });
     }
     out.sort_by(|a, b| a.omega2.abs().total_cmp(&b.omega2.abs()));
     Ok(out)
+}
+
+/// [`state_space`]'s eigenvalues without the eigenvectors (the modes' shapes are empty),
+/// and `‖L⁻¹‖_F²` (`M = LLᵀ`), which bounds `|φ|²/φᵀMφ` for any shape `φ`.
+pub fn state_space_values(
+    k: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+) -> Result<(Vec<RawMode>, f64), DenseError> {
+    let (a, linv) = first_order(k, c, m)?;
+    let s = eigenvalues_unblocked(&a).ok_or(DenseError::NoConvergence)?;
+    let mut out: Vec<RawMode> = s
+        .into_iter()
+        .filter(|z| z.im >= 0.0)
+        .map(|z| RawMode {
+            s: (z.re, z.im),
+            omega2: omega2_of(z),
+            shape: DVector::zeros(0),
+        })
+        .collect();
+    out.sort_by(|a, b| a.omega2.abs().total_cmp(&b.omega2.abs()));
+    Ok((out, linv.norm_squared()))
 }
 
 #[cfg(test)]

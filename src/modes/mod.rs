@@ -6,8 +6,9 @@
 //! an orthonormal basis `N` of the Jacobian's null space (rank-revealing: redundant joints
 //! cost nothing). [`dense`] solves the reduced problem: the symmetric generalised problem
 //! `NᵀKN φ = ω² NᵀMN φ` when the model is conservative and undamped at the state, else the
-//! quadratic problem in first-order form (frequencies and damping ratios). Rigid motions
-//! come out as exact zeros ([`dense::ZERO_FACTOR`]) and are counted. [`hht`] tells what a
+//! quadratic problem in first-order form (frequencies and damping ratios); `reduced`
+//! drives it and classifies the modes. Rigid motions come out as exact zeros
+//! ([`dense::ZERO_FACTOR`]) and are counted. [`hht`] tells what a
 //! time step resolves of each mode; [`output`] writes `modes.csv`, `modes_shapes.csv`,
 //! `summary.json`; [`cli`] is the `modes` subcommand.
 
@@ -17,6 +18,7 @@ pub mod hht;
 pub mod krylov;
 pub mod linearise;
 pub mod output;
+mod reduced;
 pub mod rotating;
 pub mod run_summary;
 pub mod sparse;
@@ -26,7 +28,7 @@ pub mod vtk;
 use crate::elements::NodeState;
 use crate::solver::system::System;
 use linearise::ElementMatrices;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use std::f64::consts::PI;
 
 /// What a mode is.
@@ -157,6 +159,13 @@ pub enum Solver {
     Auto,
     /// Always dense.
     Dense,
+    /// Dense, the frequencies alone: the modes carry no shape and no energy shares
+    /// (a run's summary, `--check`: [`about::lowest_about_initial`]). The damped or
+    /// gyroscopic first-order form then skips the eigenvectors, which cost 2/3 of its
+    /// solve (the flexible slider-crank's 138 × 138 state matrix: 18 ms of a 93 ms run); a
+    /// model where one of them is needed to tell a rigid mode from an elastic one is
+    /// solved with them.
+    DenseFrequencies,
     /// Always sparse.
     Sparse,
 }
@@ -194,7 +203,7 @@ pub fn analyse(
 ) -> Result<ModalAnalysis, ModesError> {
     let nn = sys.n_node_eq;
     let sparse = match solver {
-        Solver::Dense => false,
+        Solver::Dense | Solver::DenseFrequencies => false,
         Solver::Sparse => true,
         Solver::Auto => nn >= SPARSE_MIN_UNKNOWNS && 4 * count <= nn,
     };
@@ -207,7 +216,8 @@ pub fn analyse(
             r => return r,
         }
     }
-    analyse_dense(sys, nodes, lambda, scale, t, groups, count)
+    let shapes = solver != Solver::DenseFrequencies;
+    reduced::analyse_dense(sys, nodes, lambda, scale, t, groups, count, shapes)
 }
 
 fn group_index(groups: &[&str]) -> (Vec<String>, Vec<usize>) {
@@ -324,186 +334,7 @@ pub fn analyse_rotating(
 ) -> Result<ModalAnalysis, ModesError> {
     let lin = linearise::linearise(sys, nodes, lambda, scale, t);
     let rel = rotating::to_rotating(sys, frame, nodes, &lin);
-    solve_dense(rel, sys.n_node_eq, groups, count)
-}
-
-fn analyse_dense(
-    sys: &System,
-    nodes: &[NodeState],
-    lambda: &[f64],
-    scale: f64,
-    t: f64,
-    groups: &[&str],
-    count: usize,
-) -> Result<ModalAnalysis, ModesError> {
-    let lin = linearise::linearise(sys, nodes, lambda, scale, t);
-    solve_dense(lin, sys.n_node_eq, groups, count)
-}
-
-fn solve_dense(
-    lin: linearise::Linearised,
-    nn: usize,
-    groups: &[&str],
-    count: usize,
-) -> Result<ModalAnalysis, ModesError> {
-    let basis = linearise::null_space(&lin.b, nn);
-    let free = basis.ncols();
-    if free == 0 {
-        return Err(ModesError::NothingToVibrate(
-            "every degree of freedom is fixed or constrained".into(),
-        ));
-    }
-    let kr = basis.transpose() * &lin.k * &basis;
-    let cr = basis.transpose() * &lin.c * &basis;
-    let mr = basis.transpose() * &lin.m * &basis;
-    // The mass before the count: a massless model has nothing to vibrate, whatever the count.
-    if max_abs(&mr) == 0.0 {
-        return Err(ModesError::NothingToVibrate(
-            "no mass on any free degree of freedom".into(),
-        ));
-    }
-    if count > free {
-        return Err(ModesError::TooMany {
-            count,
-            free,
-            finite: free,
-        });
-    }
-    let kn = max_abs(&kr);
-    let asymmetry = if kn > 0.0 {
-        max_abs(&(&kr - kr.transpose())) / kn
-    } else {
-        0.0
-    };
-    let damped = max_abs(&cr) > DAMPED_TOL * (kn.max(f64::MIN_POSITIVE) * max_abs(&mr)).sqrt();
-    let regular_mass = mr.clone().cholesky().is_some();
-    let state_space = (damped || asymmetry > ASYMMETRY_TOL) && regular_mass;
-    let (method, raw) = if state_space {
-        (Method::StateSpace, dense::state_space(&kr, &cr, &mr)?)
-    } else {
-        let ks = (&kr + kr.transpose()) * 0.5;
-        let ms = (&mr + mr.transpose()) * 0.5;
-        (Method::Symmetric, dense::conservative(&ks, &ms)?)
-    };
-    let finite = raw.len();
-    if finite == 0 {
-        return Err(ModesError::NothingToVibrate(
-            "no finite mode: the free directions carry no mass".into(),
-        ));
-    }
-    if count > finite {
-        return Err(ModesError::TooMany {
-            count,
-            free,
-            finite,
-        });
-    }
-    let w2max = raw.iter().fold(0.0f64, |m, r| m.max(r.omega2.abs()));
-    // The zero threshold against the model's stiffness scale `‖K‖/‖M‖` (max-abs norms of
-    // the assembled, unreduced matrices, 1/s²), not against ω²_max alone: when every mode
-    // is a zero (a single pendulum at rest with its link horizontal), ω²_max is round-off
-    // itself and a relative threshold calls it a frequency. The entries of K carry
-    // ε‖K‖, so a computed ω² carries ε‖K‖/‖M‖ (ZERO_FACTOR of it: [`dense::ZERO_FACTOR`]);
-    // the shift of [`dense::conservative`] adds ε σ, σ = 1e-8 ω²_max (or 1e-8 1/s² on a
-    // model without stiffness): the floor `1e-8` below.
-    let stiffness_scale = model_scale(&lin.k, &lin.m).max(w2max).max(1e-8);
-    let zero = dense::ZERO_FACTOR * f64::EPSILON * stiffness_scale;
-    // Per mode, the same round-off seen through the mode's own mass: a perturbation δK of
-    // the reduced stiffness moves ω² by the Rayleigh quotient `φᵀδKφ / φᵀMφ`, at most
-    // `ε‖K‖ · |φ|²/φᵀMφ`, and `|φ|²/φᵀMφ` is 1/(the smallest mass) for a mode that moves
-    // only a light direction: a spherical pendulum's spin about its link carries the point
-    // mass's rotary inertia (1e-3 kg·m²) alone, and its ω² = 1.9e-13 1/s² of round-off, above
-    // ε‖K‖/‖M‖ (‖M‖ the 1 kg mass), was called a frequency — or, negative, an instability
-    // (issue 34 §8). ‖K‖ the max-abs norm of the reduced stiffness.
-    let k_norm = max_abs(&kr);
-    let mode_zero = |r: &dense::RawMode| {
-        let mass = r.shape.dot(&(&mr * &r.shape));
-        let norm2 = r.shape.norm_squared();
-        let own = if mass > 0.0 && norm2 > 0.0 {
-            dense::ZERO_FACTOR * f64::EPSILON * k_norm * norm2 / mass
-        } else {
-            0.0
-        };
-        zero.max(own)
-    };
-    let is_zero = |r: &dense::RawMode| r.omega2.abs() <= mode_zero(r);
-    let rigid_modes = raw.iter().filter(|r| is_zero(r)).count();
-    let w2max_finite = raw
-        .iter()
-        .filter(|r| !is_zero(r))
-        .fold(0.0f64, |m, r| m.max(r.omega2.abs()));
-    let highest_hz = w2max_finite.sqrt() / (2.0 * PI);
-    // Round-off of Re s in the first-order form `A = [0 I; −M⁻¹K −M⁻¹C]`: the dense
-    // eigen-solver is backward stable, `δA ~ ε‖A‖`, `‖A‖ ≈ max(1, ‖K‖/‖M‖, ‖C‖/‖M‖, ω²_max)`
-    // (SI units of the assembly), and moves an eigenvalue by its condition number times
-    // that. For the undamped pair `s = ±iω` the right and left eigenvectors are `(φ, sφ)`
-    // and `(sφ, φ)`-like, condition `(1 + ω²)/(2ω)`; so `|δRe s| ≲ ε‖A‖(1 + |s|²)/(2|s|)`,
-    // ZERO_FACTOR of it as for ω². Below it the sign of Re s is round-off: the mode is
-    // neither damped nor unstable (the heavy top's ζ = −1.9e-15 at |s| = 4.75 1/s; the
-    // pendulum at 0.05 s: ζ = −2.6e-6 at |s| = 5.7 1/s with ω²_max = 9.4e10 1/s²).
-    let re_tol = if method == Method::StateSpace {
-        let a_norm = 1f64.max(stiffness_scale).max(model_scale(&lin.c, &lin.m));
-        dense::ZERO_FACTOR * f64::EPSILON * a_norm
-    } else {
-        0.0
-    };
-    // Rigid first, unstable next, then by ω².
-    let mut order: Vec<&dense::RawMode> = raw.iter().collect();
-    order.sort_by_key(|r| u8::from(!is_zero(r)));
-    // Undamped gyroscopic (`C` skew, `K` symmetric — a rotating frame's Coriolis matrix):
-    // the eigenvalues of a stable model are imaginary, and a real part is the first-order
-    // form's round-off, `ε ‖A‖ κ ≈ ε ω²_max (1 + |s|²)/(2|s|)` (‖A‖ ≈ ω²_max in
-    // mass-orthonormal coordinates, κ the condition of the pair `(φ, sφ)`), ×ZERO_FACTOR:
-    // below it it is reported as zero, neither damping nor instability.
-    let skew_c = state_space
-        && asymmetry <= ASYMMETRY_TOL
-        && max_abs(&(&cr + cr.transpose()))
-            <= DAMPED_TOL * (kn.max(f64::MIN_POSITIVE) * max_abs(&mr)).sqrt();
-    let clean = |s: (f64, f64)| {
-        let a = s.0.hypot(s.1);
-        let noise = dense::ZERO_FACTOR * f64::EPSILON * w2max * (1.0 + a * a) / (2.0 * a);
-        if skew_c && a > 0.0 && s.0.abs() <= noise {
-            (0.0, s.1)
-        } else {
-            s
-        }
-    };
-    let (group_names, group_of) = group_index(groups);
-    let modes = order
-        .into_iter()
-        .take(count)
-        .map(|r| {
-            let phi: DVector<f64> = &basis * &r.shape;
-            let phi = phi.iter().copied().collect();
-            let (re, im) = r.s;
-            let w = re.hypot(im);
-            let tol = if w > 0.0 {
-                re_tol * (1.0 + w * w) / (2.0 * w)
-            } else {
-                0.0
-            };
-            let s = if re.abs() <= tol { (0.0, im) } else { r.s };
-            make_mode_s(
-                phi,
-                clean(s),
-                is_zero(r),
-                &lin.locals,
-                &group_of,
-                group_names.len(),
-            )
-        })
-        .collect();
-    Ok(ModalAnalysis {
-        modes,
-        free_unknowns: free,
-        constraints: (lin.b.nrows(), nn - free),
-        rigid_modes,
-        finite_modes: finite,
-        highest_hz,
-        method,
-        asymmetry,
-        groups: group_names,
-    })
+    reduced::solve_dense(rel, sys.n_node_eq, groups, count, true)
 }
 
 /// A conservative mode of `ω² = w2` ([`make_mode_s`] with `s = iω`, or `+√(−ω²)`).
@@ -532,7 +363,7 @@ fn make_mode_s(
     ngroups: usize,
 ) -> Mode {
     let (mut kin, mut strain) = (vec![0.0; ngroups], vec![0.0; ngroups]);
-    for (e, el) in locals.iter().enumerate() {
+    for (e, el) in locals.iter().enumerate().filter(|_| !shape.is_empty()) {
         let g = group_of.get(e).copied().unwrap_or(0);
         if g < ngroups {
             kin[g] += el.quadratic(&el.m, &shape);
