@@ -103,7 +103,8 @@ pub fn conservative(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<RawMode>, 
         .clone()
         .solve_lower_triangular(&DMatrix::identity(n, n))
         .ok_or(DenseError::NoConvergence)?;
-    let a = &linv * m * linv.transpose();
+    let linvt = linv.transpose();
+    let a = &linv * m * &linvt;
     let a = (&a + a.transpose()) * 0.5;
     let eig = SymmetricEigen::try_new(a, f64::EPSILON, 0).ok_or(DenseError::NoConvergence)?;
     let mu_max = eig.eigenvalues.iter().fold(0.0f64, |x, v| x.max(*v));
@@ -116,7 +117,7 @@ pub fn conservative(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<RawMode>, 
         }
         let z = eig.eigenvectors.column(i);
         // φ = L⁻ᵀ z, normalised to φᵀMφ = 1.
-        let phi = linv.transpose() * z;
+        let phi = &linvt * z;
         let phi = &phi / phi.dot(&(m * &phi)).sqrt();
         // ω² = 1/μ − σ carries ε(ω² + σ)²/σ from μ's absolute error ε/σ: exact enough
         // below σ; above it the Rayleigh quotient φᵀKφ/φᵀMφ (error quadratic in φ's).

@@ -42,9 +42,16 @@ pub(super) fn solve_dense(
             "every degree of freedom is fixed or constrained".into(),
         ));
     }
-    let kr = basis.transpose() * &lin.k * &basis;
-    let cr = basis.transpose() * &lin.c * &basis;
-    let mr = basis.transpose() * &lin.m * &basis;
+    // Without constraints the basis is the identity: the products would copy (exactly).
+    let unconstrained = lin.b.nrows() == 0 || lin.b.iter().all(|v| *v == 0.0);
+    let reduce = |a: &DMatrix<f64>| {
+        if unconstrained {
+            a.clone()
+        } else {
+            basis.transpose() * a * &basis
+        }
+    };
+    let (kr, cr, mr) = (reduce(&lin.k), reduce(&lin.c), reduce(&lin.m));
     // The mass before the count: a massless model has nothing to vibrate, whatever the count.
     if max_abs(&mr) == 0.0 {
         return Err(ModesError::NothingToVibrate(
@@ -137,12 +144,14 @@ pub(super) fn solve_dense(
         };
         zero.max(own)
     };
-    let is_zero = |r: &dense::RawMode| r.omega2.abs() <= mode_zero(r);
-    let rigid_modes = raw.iter().filter(|r| is_zero(r)).count();
+    // Each mode's test once (an `O(n²)` product: the sort below would repeat it).
+    let zeros: Vec<bool> = raw.iter().map(|r| r.omega2.abs() <= mode_zero(r)).collect();
+    let rigid_modes = zeros.iter().filter(|z| **z).count();
     let w2max_finite = raw
         .iter()
-        .filter(|r| !is_zero(r))
-        .fold(0.0f64, |m, r| m.max(r.omega2.abs()));
+        .zip(&zeros)
+        .filter(|(_, z)| !**z)
+        .fold(0.0f64, |m, (r, _)| m.max(r.omega2.abs()));
     let highest_hz = w2max_finite.sqrt() / (2.0 * PI);
     // Round-off of Re s in the first-order form `A = [0 I; −M⁻¹K −M⁻¹C]`: the dense
     // eigen-solver is backward stable, `δA ~ ε‖A‖`, `‖A‖ ≈ max(1, ‖K‖/‖M‖, ‖C‖/‖M‖, ω²_max)`
@@ -159,8 +168,8 @@ pub(super) fn solve_dense(
         0.0
     };
     // Rigid first, unstable next, then by ω².
-    let mut order: Vec<&dense::RawMode> = raw.iter().collect();
-    order.sort_by_key(|r| u8::from(!is_zero(r)));
+    let mut order: Vec<usize> = (0..raw.len()).collect();
+    order.sort_by_key(|&i| u8::from(!zeros[i]));
     // Undamped gyroscopic (`C` skew, `K` symmetric — a rotating frame's Coriolis matrix):
     // the eigenvalues of a stable model are imaginary, and a real part is the first-order
     // form's round-off, `ε ‖A‖ κ ≈ ε ω²_max (1 + |s|²)/(2|s|)` (‖A‖ ≈ ω²_max in
@@ -183,12 +192,17 @@ pub(super) fn solve_dense(
     let modes = order
         .into_iter()
         .take(count)
-        .map(|r| {
+        .map(|i| {
+            let r = &raw[i];
             // Frequencies alone: no shape (`make_mode_s` then gives no energy shares).
             let phi: Vec<f64> = if r.shape.is_empty() {
                 Vec::new()
             } else {
-                (&basis * &r.shape).iter().copied().collect()
+                if unconstrained {
+                    r.shape.iter().copied().collect()
+                } else {
+                    (&basis * &r.shape).iter().copied().collect()
+                }
             };
             let (re, im) = r.s;
             let w = re.hypot(im);
@@ -201,7 +215,7 @@ pub(super) fn solve_dense(
             make_mode_s(
                 phi,
                 clean(s),
-                is_zero(r),
+                zeros[i],
                 &lin.locals,
                 &group_of,
                 group_names.len(),
