@@ -195,8 +195,21 @@ pub fn quaternion<S: Real>(r: &Matrix3<S>) -> (S, Vector3<S>) {
 /// `exp(Φ̃) = R`. Accurate near 0 (series in `‖v‖²`) and at π (quaternion form).
 pub fn log<S: Real>(r: &Matrix3<S>) -> Vector3<S> {
     let (w, v) = quaternion(r);
-    let s2 = v.dot(&v);
-    // Φ = 2 atan2(|v|, w) v/|v|; the factor is smooth in |v|² near 0.
+    log_of_quaternion(w, &v)
+}
+
+/// [`log`] and `cot(φ/2)` (`φ = ‖Φ‖`) from the same unit quaternion, `cos(φ/2)/sin(φ/2) =
+/// w/‖v‖` (infinite at `φ = 0`): the coefficient of `T⁻¹(Φ)` without a `tan`.
+pub fn log_and_cot_half(r: &Matrix3<f64>) -> (Vector3<f64>, f64) {
+    let (w, v) = quaternion(r);
+    let s = v.norm();
+    (log_of_quaternion(w, &v), w / s)
+}
+
+/// `Φ = 2 atan2(|v|, w) v/|v|` of the unit quaternion `(w, v)`, `w ≥ 0`.
+fn log_of_quaternion<S: Real>(w: S, v: &Vector3<S>) -> Vector3<S> {
+    let s2 = v.dot(v);
+    // The factor is smooth in |v|² near 0.
     let k = if s2 < c::<S>(1e-4) * w * w {
         let x2 = s2 / (w * w);
         (S::one() - x2 / c(3.0) + x2 * x2 / c(5.0) - x2 * x2 * x2 / c(7.0)) * c(2.0) / w
@@ -204,7 +217,7 @@ pub fn log<S: Real>(r: &Matrix3<S>) -> Vector3<S> {
         let s = s2.sqrt();
         s.atan2(w) * c(2.0) / s
     };
-    v * k
+    *v * k
 }
 
 /// Re-orthonormalises a rotation matrix (polar projection by one Newton step, enough for
@@ -238,6 +251,27 @@ mod tests {
         assert!((l.norm() - std::f64::consts::PI).abs() < 1e-12);
         let tiny = Vector3::new(1e-9, -2e-9, 3e-9);
         assert!((log(&exp(&tiny)) - tiny).norm() < 1e-22);
+    }
+
+    /// `cot(φ/2)` from the quaternion equals `1/tan(φ/2)` (to a few ulps of its size, up to
+    /// `φ = π` where it is 0), and the rotation vector is [`log`]'s.
+    #[test]
+    fn cot_half_from_the_quaternion_is_the_cotangent() {
+        for phi in [
+            Vector3::new(0.01, 0.02, -0.03),
+            Vector3::new(0.3, -1.2, 0.5),
+            Vector3::new(2.0, 1.0, -1.5),
+            Vector3::new(0.0, 0.0, std::f64::consts::PI - 1e-9),
+        ] {
+            let r = exp(&phi);
+            let (l, cot) = log_and_cot_half(&r);
+            assert!((l - log(&r)).norm() == 0.0);
+            let want = 1.0 / (0.5 * phi.norm()).tan();
+            assert!(
+                (cot - want).abs() <= 1e-14 * (1.0 + want.abs()) / phi.norm().min(1.0),
+                "{phi:?}: {cot} vs {want}"
+            );
+        }
     }
 
     #[test]

@@ -115,6 +115,8 @@ struct Scratch {
     shift: Vec<f64>,
     /// `Λᵣᵀ Λᵢ = exp(ψ̃ᵢ)` of every node.
     rel: Vec<Matrix3<f64>>,
+    /// `cot(|ψᵢ|/2)` of every node (the residual path's `T⁻¹`).
+    cot: Vec<f64>,
     z: Vec<[f64; 6]>,
     gz: Vec<[f64; 6]>,
     jac: Vec<SMatrix<f64, 6, 12>>,
@@ -132,6 +134,7 @@ impl Scratch {
         if self.z.len() < n {
             self.shift.resize(n, 0.0);
             self.rel.resize(n, Matrix3::identity());
+            self.cot.resize(n, 0.0);
             self.z.resize(n, [0.0; 6]);
             self.gz.resize(n, [0.0; 6]);
             self.jac.resize(n, SMatrix::zeros());
@@ -276,8 +279,9 @@ impl BeamP {
         let mut z = vec![[0.0; 6]; n];
         let mut shift = vec![0.0; n];
         let mut rel = vec![Matrix3::identity(); n];
+        let mut cot = vec![0.0; n];
         let idx: Vec<usize> = (0..n).collect();
-        beam.locals(&rest, &idx, &mut z, &mut shift, &mut rel);
+        beam.locals(&rest, &idx, &mut z, &mut shift, &mut rel, &mut cot);
         let mut pts = std::mem::take(&mut beam.stiff);
         pts.push(beam.mid.clone());
         for q in &mut pts {
@@ -300,8 +304,8 @@ impl BeamP {
         self.length
     }
 
-    /// Local numbers `zᵢ`, branch shifts and relative rotations `Λᵣᵀ Λᵢ` of every node
-    /// (f64); `idx[k]` is node `k`'s index into `nodes`.
+    /// Local numbers `zᵢ`, branch shifts, relative rotations `Λᵣᵀ Λᵢ` and `cot(|ψᵢ|/2)` of
+    /// every node (f64); `idx[k]` is node `k`'s index into `nodes`.
     fn locals(
         &self,
         nodes: &[NodeState],
@@ -309,6 +313,7 @@ impl BeamP {
         z: &mut [[f64; 6]],
         shift: &mut [f64],
         rel: &mut [Matrix3<f64>],
+        cot: &mut [f64],
     ) {
         let n = idx.len();
         let m = self.refn;
@@ -317,16 +322,20 @@ impl BeamP {
         z[m] = [0.0; 6];
         shift[m] = 0.0;
         rel[m] = Matrix3::identity();
+        cot[m] = f64::INFINITY;
         let mut set = |k: usize, prev: Vector3<f64>| {
             rel[k] = lr.transpose() * nodes[idx[k]].r * self.lambda0[k];
-            let f = rotation::log(&rel[k]);
+            let (f, ch) = rotation::log_and_cot_half(&rel[k]);
             let s = branch(&f, &prev);
             shift[k] = s;
-            let psi = if s != 0.0 {
-                f * (1.0 + s / f.norm())
+            // |ψ|/2 = |φ/2 + πk|, and cot has the period π: cot(|ψ|/2) = ± cot(φ/2).
+            let (psi, ch) = if s != 0.0 {
+                let t = 1.0 + s / f.norm();
+                (f * t, if t < 0.0 { -ch } else { ch })
             } else {
-                f
+                (f, ch)
             };
+            cot[k] = ch;
             let y = lr.transpose() * (nodes[idx[k]].x - sr.x);
             z[k] = [y.x, y.y, y.z, psi.x, psi.y, psi.z];
             psi
@@ -356,6 +365,7 @@ impl BeamP {
                 &mut sc.z[..n],
                 &mut sc.shift[..n],
                 &mut sc.rel[..n],
+                &mut sc.cot[..n],
             );
             f(sc, n)
         })

@@ -27,14 +27,15 @@ fn point_coefficients(x: f64) -> [f64; 5] {
 }
 
 /// `T⁻ᵀ(ψ) g = g − ½ ψ × g + e ψ × (ψ × g)` with `e = (1 − (φ/2) cot(φ/2))/φ²`
-/// ([`crate::rotation::tangent_inv`] applied by cross products; the same series below `φ² = 0.01`).
-fn tangent_inv_t(psi: &Vector3<f64>, g: &Vector3<f64>) -> Vector3<f64> {
+/// ([`crate::rotation::tangent_inv`] applied by cross products; the same series below
+/// `φ² = 0.01`), `cot_half = cot(φ/2)` from the node's quaternion
+/// ([`crate::rotation::log_and_cot_half`], [`BeamP::locals`]).
+fn tangent_inv_t(psi: &Vector3<f64>, cot_half: f64, g: &Vector3<f64>) -> Vector3<f64> {
     let p = psi.norm_squared();
     let e = if p < 1e-2 {
         1.0 / 12.0 + p / 720.0 + p * p / 30240.0 + p * p * p / 1209600.0
     } else {
-        let h = 0.5 * p.sqrt();
-        (1.0 - h / h.tan()) / p
+        (1.0 - 0.5 * p.sqrt() * cot_half) / p
     };
     let pg = psi.cross(g);
     g - pg * 0.5 + psi.cross(&pg) * e
@@ -111,7 +112,7 @@ impl BeamP {
                 let gy = Vector3::new(sc.gz[i][0], sc.gz[i][1], sc.gz[i][2]);
                 let gp = Vector3::new(sc.gz[i][3], sc.gz[i][4], sc.gz[i][5]);
                 let fx = lr * gy;
-                let tig = tangent_inv_t(&psi, &gp);
+                let tig = tangent_inv_t(&psi, sc.cot[i], &gp);
                 let fth = self.lambda0[i] * tig;
                 fxr -= fx;
                 fthr += l0r * (gy.cross(&y) - sc.rel[i] * tig);
