@@ -18,6 +18,29 @@ pub struct TimeLaw {
     /// A value set between steps by a program driving the run, replacing `a f(t)` from
     /// its start on ([`TimeLaw::set_value`]).
     set: Option<Transition>,
+    /// The law's last evaluation.
+    last: Last,
+}
+
+/// The last `(t, [a f, a ḟ, a f̈])` of a law: every Newton iteration of a step asks for the
+/// same time, and an expression's jet costs microseconds (Kane's spin-up of benches/peers/:
+/// 27 % of its run evaluated its driver's law again at each iteration). A pure function of
+/// `t`, so the value kept is the value computed. Shared between threads (elements are
+/// `Sync`): a lock that is taken computes afresh. A copy starts empty; it is not part of a
+/// law's identity.
+#[derive(Debug, Default)]
+struct Last(std::sync::Mutex<Option<(f64, [f64; 3])>>);
+
+impl Clone for Last {
+    fn clone(&self) -> Self {
+        Last::default()
+    }
+}
+
+impl PartialEq for Last {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// A driver's value set between steps (issue 36 §5): from the time `t0` it was set, the
@@ -104,6 +127,7 @@ impl TimeLaw {
             function: model.functions[&drive.function].function.clone(),
             amplitude: drive.amplitude,
             set: None,
+            last: Last::default(),
         }
     }
 
@@ -113,6 +137,7 @@ impl TimeLaw {
             function,
             amplitude,
             set: None,
+            last: Last::default(),
         }
     }
 
@@ -167,12 +192,22 @@ impl TimeLaw {
         if let Some(s) = &self.set {
             return s.at(t);
         }
+        let mut last = self.last.0.try_lock().ok();
+        if let Some(Some((t_last, v))) = last.as_deref()
+            && t_last.to_bits() == t.to_bits()
+        {
+            return *v;
+        }
         let [f, fd, fdd] = self.function.derivatives(t).unwrap_or([0.0; 3]);
-        [
+        let v = [
             self.amplitude * f,
             self.amplitude * fd,
             self.amplitude * fdd,
-        ]
+        ];
+        if let Some(l) = last.as_deref_mut() {
+            *l = Some((t, v));
+        }
+        v
     }
 
     /// `a f(t)`.
@@ -188,6 +223,28 @@ mod tests {
     /// The transition's quintic meets its six end conditions, its rate and acceleration
     /// are the derivatives of its value (central differences, error O(δ²) ≈ 1e-9), and a
     /// change at once is refused unless the law is already at rest at the target.
+    /// The kept last evaluation gives what a fresh evaluation gives, bit for bit, at the
+    /// same time and after others; a value set between steps replaces it from its time on.
+    #[test]
+    fn the_last_evaluation_kept_is_the_law() {
+        let f = Function::Harmonic {
+            cosine: false,
+            amplitude: 1.0,
+            omega: 2.0,
+            phase: 0.1,
+            start: None,
+        };
+        let mut law = TimeLaw::new(f.clone(), 0.5);
+        let fresh = |t: f64| TimeLaw::new(f.clone(), 0.5).at(t);
+        for t in [0.3, 0.3, 0.7, 0.3, 0.3] {
+            assert_eq!(law.at(t).map(f64::to_bits), fresh(t).map(f64::to_bits));
+        }
+        assert_eq!(law.value(0.3), fresh(0.3)[0]);
+        law.set_value(0.3, 0.2, 0.4).unwrap();
+        assert_eq!(law.at(0.9), [0.2, 0.0, 0.0]);
+        assert_ne!(law.at(0.5), fresh(0.5));
+    }
+
     #[test]
     fn transition_is_c2_at_both_ends() {
         let mut law = TimeLaw::new(
