@@ -18,18 +18,22 @@ pub struct TimeLaw {
     /// A value set between steps by a program driving the run, replacing `a f(t)` from
     /// its start on ([`TimeLaw::set_value`]).
     set: Option<Transition>,
-    /// The law's last evaluation.
+    /// The law's last evaluations.
     last: Last,
 }
 
-/// The last `(t, [a f, a ḟ, a f̈])` of a law: every Newton iteration of a step asks for the
-/// same time, and an expression's jet costs microseconds (Kane's spin-up of benches/peers/:
-/// 27 % of its run evaluated its driver's law again at each iteration). A pure function of
-/// `t`, so the value kept is the value computed. Shared between threads (elements are
-/// `Sync`): a lock that is taken computes afresh. A copy starts empty; it is not part of a
-/// law's identity.
+/// The last two `(t, [a f, a ḟ, a f̈])` of a law: every Newton iteration of a step asks for
+/// the same time, and the accepted step's powers for its two ends; an expression's jet
+/// costs microseconds (Kane's spin-up of benches/peers/: 27 % of its run evaluated its
+/// driver's law again at each iteration). A pure function of `t`, so the value kept is the
+/// value computed. Shared between threads (elements are `Sync`): a lock that is taken
+/// computes afresh. A copy starts empty; it is not part of a law's identity.
+/// (Boxed: a law is held by value in larger enums, as the PID controller's target.)
 #[derive(Debug, Default)]
-struct Last(std::sync::Mutex<Option<(f64, [f64; 3])>>);
+struct Last(Box<std::sync::Mutex<[Kept; 2]>>);
+
+/// A time and the law's `[a f, a ḟ, a f̈]` there.
+type Kept = Option<(f64, [f64; 3])>;
 
 impl Clone for Last {
     fn clone(&self) -> Self {
@@ -193,8 +197,11 @@ impl TimeLaw {
             return s.at(t);
         }
         let mut last = self.last.0.try_lock().ok();
-        if let Some(Some((t_last, v))) = last.as_deref()
-            && t_last.to_bits() == t.to_bits()
+        if let Some(kept) = last.as_deref()
+            && let Some((_, v)) = kept
+                .iter()
+                .flatten()
+                .find(|(u, _)| u.to_bits() == t.to_bits())
         {
             return *v;
         }
@@ -204,8 +211,8 @@ impl TimeLaw {
             self.amplitude * fd,
             self.amplitude * fdd,
         ];
-        if let Some(l) = last.as_deref_mut() {
-            *l = Some((t, v));
+        if let Some(kept) = last.as_deref_mut() {
+            *kept = [Some((t, v)), kept[0]];
         }
         v
     }
