@@ -146,39 +146,10 @@ pub fn conservative(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<RawMode>, 
 /// (a swap of its deflation window looping in `lasy2`), and a run's summary hung on it
 /// past SIGTERM. Same factorisation (Hessenberg, Schur, back substitution), O(n³).
 fn eigen_unblocked(a: &Mat<f64>) -> Option<(Vec<faer::c64>, Mat<faer::c64>)> {
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::linalg::evd::{ComputeEigenvectors, EvdParams, evd_real, evd_scratch};
-    if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return None;
-    }
+    let (re, im, ur) = francis_unblocked(a, true)?;
+    let ur = ur?;
     let n = a.nrows();
-    let mut params: faer::Spec<EvdParams, f64> =
-        faer::Spec::new(<EvdParams as faer::Auto<f64>>::auto());
-    params.config.schur.blocking_threshold = usize::MAX;
-    let par = faer::Par::Seq;
-    let mut ur = Mat::<f64>::zeros(n, n);
-    let mut s_re = faer::diag::Diag::<f64>::zeros(n);
-    let mut s_im = faer::diag::Diag::<f64>::zeros(n);
-    let mut buf = MemBuffer::new(evd_scratch::<f64>(
-        n,
-        ComputeEigenvectors::No,
-        ComputeEigenvectors::Yes,
-        par,
-        params,
-    ));
-    evd_real(
-        a.as_ref(),
-        s_re.as_mut(),
-        s_im.as_mut(),
-        None,
-        Some(ur.as_mut()),
-        par,
-        MemStack::new(&mut buf),
-        params,
-    )
-    .ok()?;
     // Real eigenvalues: their column; a conjugate pair: columns (re, im) of the first.
-    let (re, im) = (s_re.column_vector(), s_im.column_vector());
     let mut s = Vec::with_capacity(n);
     let mut u = Mat::<faer::c64>::zeros(n, n);
     let mut j = 0;
@@ -241,6 +212,21 @@ fn omega2_of(z: faer::c64) -> f64 {
 /// [`eigen_unblocked`]'s eigenvalues alone (the same Francis QR on the Hessenberg form,
 /// without accumulating the Schur vectors or solving for the eigenvectors).
 fn eigenvalues_unblocked(a: &Mat<f64>) -> Option<Vec<faer::c64>> {
+    let (re, im, _) = francis_unblocked(a, false)?;
+    Some(
+        (0..a.nrows())
+            .map(|j| faer::c64::new(re[j], im[j]))
+            .collect(),
+    )
+}
+
+/// The eigenvalues' real and imaginary parts and, when asked for, faer's real right
+/// eigenvectors (a conjugate pair in two columns).
+type Francis = (Vec<f64>, Vec<f64>, Option<Mat<f64>>);
+
+/// [`Francis`] of `a` by the unblocked QR ([`eigen_unblocked`]), the eigenvectors with
+/// `vectors`; `None` for a non-finite entry or no convergence.
+fn francis_unblocked(a: &Mat<f64>, vectors: bool) -> Option<Francis> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::evd::{ComputeEigenvectors, EvdParams, evd_real, evd_scratch};
     if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
@@ -251,12 +237,18 @@ fn eigenvalues_unblocked(a: &Mat<f64>) -> Option<Vec<faer::c64>> {
         faer::Spec::new(<EvdParams as faer::Auto<f64>>::auto());
     params.config.schur.blocking_threshold = usize::MAX;
     let par = faer::Par::Seq;
+    let mut ur = vectors.then(|| Mat::<f64>::zeros(n, n));
     let mut s_re = faer::diag::Diag::<f64>::zeros(n);
     let mut s_im = faer::diag::Diag::<f64>::zeros(n);
+    let want = if vectors {
+        ComputeEigenvectors::Yes
+    } else {
+        ComputeEigenvectors::No
+    };
     let mut buf = MemBuffer::new(evd_scratch::<f64>(
         n,
         ComputeEigenvectors::No,
-        ComputeEigenvectors::No,
+        want,
         par,
         params,
     ));
@@ -265,14 +257,15 @@ fn eigenvalues_unblocked(a: &Mat<f64>) -> Option<Vec<faer::c64>> {
         s_re.as_mut(),
         s_im.as_mut(),
         None,
-        None,
+        ur.as_mut().map(|u| u.as_mut()),
         par,
         MemStack::new(&mut buf),
         params,
     )
     .ok()?;
-    let (re, im) = (s_re.column_vector(), s_im.column_vector());
-    Some((0..n).map(|j| faer::c64::new(re[j], im[j])).collect())
+    let re = s_re.column_vector().iter().copied().collect();
+    let im = s_im.column_vector().iter().copied().collect();
+    Some((re, im, ur))
 }
 
 /// The reduced damped or gyroscopic problem's modes (first-order form), one per conjugate
