@@ -267,6 +267,12 @@ pub fn moment_stiffness(sys: &System, nodes: &[NodeState], t: f64) -> Vec<(usize
 /// on σ): 1e-6 sits between those and any honest constraint.
 const NULL_SPACE_TOL: f64 = 1e-6;
 
+/// Whether the constraint Jacobian `b` constrains nothing (no rows, or only zeros):
+/// [`null_space`] is then the identity.
+pub fn unconstrained(b: &DMatrix<f64>) -> bool {
+    b.nrows() == 0 || b.iter().all(|v| *v == 0.0)
+}
+
 /// An orthonormal basis `N` (columns) of the null space of `b` (`n` columns): the free
 /// motions the constraints allow. Rank-revealing (redundant rows, as a four-bar's
 /// hinges, cost nothing): the eigenvectors of `BᵀB` (rows scaled to unit norm) whose
@@ -279,7 +285,7 @@ pub fn null_space(b: &DMatrix<f64>, n: usize) -> DMatrix<f64> {
             r /= norm;
         }
     }
-    if rows.nrows() == 0 || rows.iter().all(|v| *v == 0.0) {
+    if unconstrained(&rows) {
         return DMatrix::identity(n, n);
     }
     let btb = rows.transpose() * &rows;

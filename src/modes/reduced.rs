@@ -43,7 +43,7 @@ pub(super) fn solve_dense(
         ));
     }
     // Without constraints the basis is the identity: the products would copy (exactly).
-    let unconstrained = lin.b.nrows() == 0 || lin.b.iter().all(|v| *v == 0.0);
+    let unconstrained = linearise::unconstrained(&lin.b);
     let reduce = |a: &DMatrix<f64>| {
         if unconstrained {
             a.clone()
@@ -111,16 +111,15 @@ pub(super) fn solve_dense(
             finite,
         });
     }
-    let w2max = raw.iter().fold(0.0f64, |m, r| m.max(r.omega2.abs()));
     // The zero threshold against the model's stiffness scale `‖K‖/‖M‖` (max-abs norms of
     // the assembled, unreduced matrices, 1/s²), not against ω²_max alone: when every mode
     // is a zero (a single pendulum at rest with its link horizontal), ω²_max is round-off
     // itself and a relative threshold calls it a frequency. The entries of K carry
     // ε‖K‖, so a computed ω² carries ε‖K‖/‖M‖ (ZERO_FACTOR of it: [`dense::ZERO_FACTOR`]);
     // the shift of [`dense::conservative`] adds ε σ, σ = 1e-8 ω²_max (or 1e-8 1/s² on a
-    // model without stiffness): the floor `1e-8` below.
-    let stiffness_scale = model_scale(&lin.k, &lin.m).max(w2max).max(1e-8);
-    let zero = model_zero(&lin, &raw);
+    // model without stiffness): the floor `1e-8` ([`scales`]).
+    let (w2max, stiffness_scale) = scales(&lin, &raw);
+    let zero = dense::ZERO_FACTOR * f64::EPSILON * stiffness_scale;
     // Per mode, the same round-off seen through the mode's own mass: a perturbation δK of
     // the reduced stiffness moves ω² by the Rayleigh quotient `φᵀδKφ / φᵀMφ`, at most
     // `ε‖K‖ · |φ|²/φᵀMφ`, and `|φ|²/φᵀMφ` is 1/(the smallest mass) for a mode that moves
@@ -235,11 +234,11 @@ pub(super) fn solve_dense(
     })
 }
 
-/// The model's zero of `ω²` ([`solve_dense`]): `ZERO_FACTOR ε` times its stiffness scale.
-fn model_zero(lin: &linearise::Linearised, raw: &[dense::RawMode]) -> f64 {
+/// `ω²_max` of the computed modes and the model's stiffness scale
+/// `max(‖K‖/‖M‖, ω²_max, 1e-8)`, 1/s² ([`solve_dense`]'s zero is `ZERO_FACTOR ε` times it).
+fn scales(lin: &linearise::Linearised, raw: &[dense::RawMode]) -> (f64, f64) {
     let w2max = raw.iter().fold(0.0f64, |m, r| m.max(r.omega2.abs()));
-    let stiffness_scale = model_scale(&lin.k, &lin.m).max(w2max).max(1e-8);
-    dense::ZERO_FACTOR * f64::EPSILON * stiffness_scale
+    (w2max, model_scale(&lin.k, &lin.m).max(w2max).max(1e-8))
 }
 
 /// The model's zero of `ω²` and the largest a mode's own zero can be: `ZERO_FACTOR ε ‖K‖
@@ -251,7 +250,7 @@ fn zero_bounds(
     kr: &DMatrix<f64>,
     light: f64,
 ) -> (f64, f64) {
-    let zero = model_zero(lin, raw);
+    let zero = dense::ZERO_FACTOR * f64::EPSILON * scales(lin, raw).1;
     (
         zero,
         zero.max(dense::ZERO_FACTOR * f64::EPSILON * max_abs(kr) * light),
