@@ -197,13 +197,17 @@ impl TimeLaw {
             return s.at(t);
         }
         let mut last = self.last.0.try_lock().ok();
-        if let Some(kept) = last.as_deref()
-            && let Some((_, v)) = kept
+        if let Some(kept) = last.as_deref_mut()
+            && let Some(i) = kept
                 .iter()
-                .flatten()
-                .find(|(u, _)| u.to_bits() == t.to_bits())
+                .position(|k| k.is_some_and(|(u, _)| u.to_bits() == t.to_bits()))
         {
-            return *v;
+            // The one used last goes first, so that the next new time replaces the other:
+            // a step asks for t_{n+1} (Newton), then t_n and t_{n+1} (the accepted step's
+            // powers), then t_{n+2}: kept by first use, t_n would push t_{n+1} out before
+            // the next step's t_n was asked, one evaluation more per step.
+            kept.swap(0, i);
+            return kept[0].map_or([0.0; 3], |(_, v)| v);
         }
         let [f, fd, fdd] = self.function.derivatives(t).unwrap_or([0.0; 3]);
         let v = [
@@ -247,6 +251,13 @@ mod tests {
             assert_eq!(law.at(t).map(f64::to_bits), fresh(t).map(f64::to_bits));
         }
         assert_eq!(law.value(0.3), fresh(0.3)[0]);
+        // A run's order: t_{n+1} by Newton, then t_n and t_{n+1} for the step's powers,
+        // then t_{n+2}: the step's end stays kept for the next step's start.
+        for t in [1.0, 0.9, 1.0, 1.1] {
+            law.at(t);
+        }
+        let kept = *law.last.0.lock().unwrap();
+        assert_eq!(kept.map(|k| k.map(|(t, _)| t)), [Some(1.1), Some(1.0)]);
         law.set_value(0.3, 0.2, 0.4).unwrap();
         assert_eq!(law.at(0.9), [0.2, 0.0, 0.0]);
         assert_ne!(law.at(0.5), fresh(0.5));
