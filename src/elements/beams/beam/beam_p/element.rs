@@ -84,7 +84,7 @@ impl Element for BeamP {
             let z = &sc.z;
             self.stiff
                 .iter()
-                .map(|q| q.wj * self.density(q, &Self::point_vars(q, &z[..n])))
+                .map(|q| q.wj * self.density_f64(q, &Self::point_vars(q, &z[..n])))
                 .sum::<f64>()
         });
         let mut kinetic = 0.0;

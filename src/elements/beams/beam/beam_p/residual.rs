@@ -41,32 +41,78 @@ fn tangent_inv_t(psi: &Vector3<f64>, cot_half: f64, g: &Vector3<f64>) -> Vector3
     g - pg * 0.5 + psi.cross(&pg) * e
 }
 
+/// A point's strains in `f64` from its nine local numbers `(ψ, ψ_s, y_s)`, by cross
+/// products with the coefficients of one `sin`/`cos` ([`point_coefficients`]):
+/// `a = exp(ψ̃)ᵀ y_s` (`exp(ψ̃) = I + a ψ̃ + b ψ̃²`) and `T(ψ) ψ_s` (`T(ψ) = I − b ψ̃ + d ψ̃²`),
+/// the `(Γ, K)` of [`super::point_strains`], with what the gradient reuses.
+struct Strains {
+    psi: Vector3<f64>,
+    dpsi: Vector3<f64>,
+    /// [`point_coefficients`] of `|ψ|²`.
+    co: [f64; 5],
+    /// `exp(ψ̃)ᵀ y_s`.
+    gamma: Vector3<f64>,
+    /// `ψ × ψ_s`, `ψ × (ψ × ψ_s)`.
+    pv: Vector3<f64>,
+    ppv: Vector3<f64>,
+    /// `T(ψ) ψ_s`.
+    kappa: Vector3<f64>,
+}
+
+/// `u + α ψ × u + β ψ × (ψ × u)`.
+fn op(psi: &Vector3<f64>, al: f64, be: f64, u: &Vector3<f64>) -> Vector3<f64> {
+    let pu = psi.cross(u);
+    u + pu * al + psi.cross(&pu) * be
+}
+
+impl Strains {
+    fn of(v: &[f64; 9]) -> Self {
+        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+        let (psi, dpsi, dy) = (at(0), at(3), at(6));
+        let co = point_coefficients(psi.norm_squared());
+        let [a, b, d, _, _] = co;
+        let pv = psi.cross(&dpsi);
+        let ppv = psi.cross(&pv);
+        Strains {
+            gamma: op(&psi, -a, b, &dy),
+            kappa: dpsi - pv * b + ppv * d,
+            psi,
+            dpsi,
+            co,
+            pv,
+            ppv,
+        }
+    }
+}
+
 impl BeamP {
+    /// [`Self::density`] in `f64` (the energy guard's strain energy at every step):
+    /// `½ Γ·C_N Γ + ½ K·C_M K` from [`Strains`]. Equal to the generic path to round-off
+    /// (tested).
+    pub(super) fn density_f64(&self, q: &Point, v: &[f64; 9]) -> f64 {
+        let s = Strains::of(v);
+        let g = s.gamma - q.gamma0;
+        let k = s.kappa - q.kappa0;
+        0.5 * (g.component_mul(&self.props.cn).dot(&g) + k.component_mul(&self.props.cm).dot(&k))
+    }
+
     /// [`Self::density_grad`] in `f64` for the residual path: the same formulas with
     /// `exp(ψ̃) = I + a ψ̃ + b ψ̃²`, `T(ψ) = I − b ψ̃ + d ψ̃²` applied as cross products and
     /// the coefficients `a, b, d, b′, d′` from one evaluation of `sin φ`, `cos φ`
     /// ([`point_coefficients`]). Equal to the generic path to round-off (tested).
     fn density_grad_f64(&self, q: &Point, v: &[f64; 9]) -> [f64; 9] {
-        let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
-        let (psi, dpsi, dy) = (at(0), at(3), at(6));
-        let [a, b, d, db, dd] = point_coefficients(psi.norm_squared());
-        // u + α ψ × u + β ψ × (ψ × u)
-        let op = |al: f64, be: f64, u: &Vector3<f64>| {
-            let pu = psi.cross(u);
-            u + pu * al + psi.cross(&pu) * be
-        };
-        let av = op(-a, b, &dy); // exp(ψ̃)ᵀ y_s
-        let pv = psi.cross(&dpsi);
-        let ppv = psi.cross(&pv);
-        let tv = dpsi - pv * b + ppv * d; // T(ψ) ψ_s
+        let s = Strains::of(v);
+        let (psi, dpsi) = (&s.psi, &s.dpsi);
+        let [a, b, d, db, dd] = s.co;
+        let (av, pv, ppv) = (s.gamma, s.pv, s.ppv);
         let nn = (av - q.gamma0).component_mul(&self.props.cn);
-        let mm = (tv - q.kappa0).component_mul(&self.props.cm);
-        let g_dy = op(a, b, &nn);
-        let g_dpsi = op(b, d, &mm); // T(ψ)ᵀ M
-        let g_psi = op(b, d, &nn.cross(&av)) - psi * (2.0 * db * pv.dot(&mm))
-            + mm.cross(&dpsi) * b
+        let mm = (s.kappa - q.kappa0).component_mul(&self.props.cm);
+        let g_dy = op(psi, a, b, &nn);
+        let g_dpsi = op(psi, b, d, &mm); // T(ψ)ᵀ M
+        let g_psi = op(psi, b, d, &nn.cross(&av)) - psi * (2.0 * db * pv.dot(&mm))
+            + mm.cross(dpsi) * b
             + psi * (2.0 * dd * ppv.dot(&mm))
-            - (mm.cross(&pv) + mm.cross(&psi).cross(&dpsi)) * d;
+            - (mm.cross(&pv) + mm.cross(psi).cross(dpsi)) * d;
         [
             g_psi.x, g_psi.y, g_psi.z, g_dpsi.x, g_dpsi.y, g_dpsi.z, g_dy.x, g_dy.y, g_dy.z,
         ]

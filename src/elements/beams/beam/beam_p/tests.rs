@@ -261,6 +261,42 @@ fn consistent_mass_integrates_the_kinetic_energy_of_a_rigid_translation() {
 }
 
 #[test]
+fn f64_energy_density_equals_the_generic_one() {
+    // The energy guard's strain energy (`density_f64`: cross products, one sin/cos per
+    // point) against the generic `density` (matrices from `rotation`): the same formula,
+    // so equal to round-off of the largest term (1e-12 of it, as the residual paths below),
+    // with small rotations in the series branch and rotations past π from the reference node.
+    for p in [1, 3, 5, 8] {
+        let (x1, x2) = (Vector3::new(0.1, 0.2, -0.1), Vector3::new(0.4, 0.25, 0.05));
+        let (b, x0) = straight(p, x1, x2);
+        for (seed, du, dr) in [(3, 1e-3, 0.01), (5, 0.01, 0.5), (9, 0.05, 3.0)] {
+            let st = random_states(&x0, du, dr, seed + p as u64);
+            b.with_locals(&st, |sc, n| {
+                for q in &b.stiff {
+                    let v = BeamP::point_vars(q, &sc.z[..n]);
+                    let (fast, full) = (b.density_f64(q, &v), b.density(q, &v));
+                    let at = |k: usize| Vector3::new(v[k], v[k + 1], v[k + 2]);
+                    let (g, k) = point_strains(&at(0), &at(3), &at(6));
+                    let big = 0.5
+                        * ((g - q.gamma0)
+                            .abs()
+                            .component_mul(&(g.abs() + q.gamma0.abs()))
+                            .dot(&b.props.cn)
+                            + (k - q.kappa0)
+                                .abs()
+                                .component_mul(&(k.abs() + q.kappa0.abs()))
+                                .dot(&b.props.cm));
+                    assert!(
+                        (fast - full).abs() <= 1e-12 * big.max(f64::MIN_POSITIVE),
+                        "p {p}, seed {seed}: {fast} vs {full}"
+                    );
+                }
+            });
+        }
+    }
+}
+
+#[test]
 fn residual_path_equals_the_tangent_path_for_every_order() {
     // The residual path (`internal_forces`: f64 cross-product formulas, one sin/cos per
     // point, `exp(ψ̃ᵢ)` taken from the relative rotations) and the tangent path (generic
