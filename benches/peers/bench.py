@@ -2,7 +2,7 @@
 """Work-precision of mecano-rs and its peers on the same scenes (benches/peers/README.md).
 
     python3 benches/peers/bench.py [--out out/peers] [--scenes a,b] [--codes mecano-rs,exudyn,mbdyn]
-                                   [--rounds R] [--quick] [--ladder PEER=N:H,...] [--append]
+                                   [--rounds R] [--quick] [--ladder PEER=N:H[:RTOL],...] [--append]
 
 For each scene: a converged reference (mecano-rs on a mesh and step finer than any run, with
 a second, coarser run that bounds its own error), then each code's ladder of meshes and
@@ -195,17 +195,21 @@ PEERS_RUN = {
 }
 
 
-def run_peer(code, scene, n, h, out):
-    """Runs a peer's configuration (n elements per bar/leg/beam/rod, step h) through its script;
+def run_peer(code, scene, n, h, out, reltol=None):
+    """Runs a peer's configuration (n elements per bar/leg/beam/rod, step h, and for Exudyn
+    optionally Newton's relative tolerance instead of the bench's 1e-8) through its script;
     returns its record (no error yet)."""
     py, script, words, scheme = PEERS_RUN[code]
     os.makedirs(out, exist_ok=True)
     csvp = os.path.join(out, "run.csv")
     if os.path.exists(csvp):
         os.remove(csvp)
-    p = subprocess.run([py, os.path.join(PEERS, script), scene, "--h", repr(h), "--n", str(n), "--out", csvp],
-                       capture_output=True, text=True)
-    rec = dict(code=code, scene=scene, label=f"{n} {words} per {SCENES[scene]['per']}, {scheme(scene)}, h = {h:g}",
+    extra = ["--reltol", repr(reltol)] if reltol is not None else []
+    p = subprocess.run([py, os.path.join(PEERS, script), scene, "--h", repr(h), "--n", str(n), "--out", csvp]
+                       + extra, capture_output=True, text=True)
+    tol = f", Newton rel. tol. {reltol:g}" if reltol is not None else ""
+    rec = dict(code=code, scene=scene,
+               label=f"{n} {words} per {SCENES[scene]['per']}, {scheme(scene)}, h = {h:g}{tol}",
                h=h, mesh=f"{n} {words}", scheme=scheme(scene))
     j = {}
     try:
@@ -270,9 +274,10 @@ def main():
     ap.add_argument("--codes", default="mecano-rs,exudyn,mbdyn")
     ap.add_argument("--rounds", type=int, default=1, help="timed runs per configuration (best of)")
     ap.add_argument("--quick", action="store_true", help="only each code's cheapest two configurations")
-    ap.add_argument("--ladder", action="append", default=[], metavar="PEER=N:H,...",
-                    help="a peer's rungs instead of the scene's ladder (e.g. exudyn=80:2.5e-5,160:1e-5), run in "
-                         "OUT/<scene>/<peer>_n<N>_h<H>")
+    ap.add_argument("--ladder", action="append", default=[], metavar="PEER=N:H[:RTOL],...",
+                    help="a peer's rungs instead of the scene's ladder (e.g. exudyn=80:2.5e-5,160:1e-5; for Exudyn "
+                         "a third field sets Newton's relative tolerance, e.g. exudyn=40:0.025:1e-4), run in "
+                         "OUT/<scene>/<peer>_n<N>_h<H>[_rtol<RTOL>]")
     ap.add_argument("--append", action="store_true",
                     help="add this sitting's records to OUT/runs.jsonl (a scene's reference once) instead of replacing it")
     a = ap.parse_args()
@@ -282,9 +287,12 @@ def main():
         if code not in PEERS_RUN:
             sys.exit(f"--ladder {spec}: {code!r} is not a peer ({', '.join(PEERS_RUN)})")
         try:
-            ladders[code] = [(int(n), float(h)) for n, h in (r.split(":") for r in rungs.split(","))]
+            ladders[code] = [tuple(int(v) if i == 0 else float(v) for i, v in enumerate(r.split(":")))
+                             for r in rungs.split(",")]
+            if any(len(c) not in (2, 3) or (len(c) == 3 and code != "exudyn") for c in ladders[code]):
+                raise ValueError
         except ValueError:
-            sys.exit(f"--ladder {spec}: expected PEER=N:H,N:H (elements per bar, step in s)")
+            sys.exit(f"--ladder {spec}: expected PEER=N:H,N:H (elements per bar, step in s; Exudyn: N:H:RTOL too)")
     os.makedirs(a.out, exist_ok=True)
     status = peer_status(a.out)
     codes = a.codes.split(",")
@@ -328,13 +336,14 @@ def main():
             if a.quick:
                 ladder = ladder[:2]
             for i, cfg in enumerate(ladder):
-                d = os.path.join(sd, f"{code}_n{cfg[0]}_h{cfg[1]:g}" if code in ladders else f"{code}_{i}")
+                d = os.path.join(sd, f"{code}_n{cfg[0]}_h{cfg[1]:g}" + "".join(f"_rtol{t:g}" for t in cfg[2:])
+                                 if code in ladders else f"{code}_{i}")
                 best = None
                 for _ in range(a.rounds):
                     if code == "mecano-rs":
                         r = run_mecano(scene, cfg, d)
                     else:
-                        r = run_peer(code, scene, cfg[0], cfg[1], d)
+                        r = run_peer(code, scene, cfg[0], cfg[1], d, *cfg[2:])
                     if best is None or (r["ok"] and best["ok"] and r["cpu"] < best["cpu"]):
                         best = r if best is None or r["ok"] else best
                     if not r["ok"]:

@@ -302,6 +302,8 @@ def main():
     ap.add_argument("--n", type=int, required=True)
     ap.add_argument("--tend", type=float, help="end time (default: the scene's)")
     ap.add_argument("--abstol", type=float, help="Newton's absolute tolerance (default: the scene's)")
+    ap.add_argument("--reltol", type=float, default=1e-8,
+                    help="Newton's relative tolerance (default 1e-8, the bench's)")
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
     sc = SCENES[a.scene]
@@ -322,7 +324,7 @@ def main():
     ti.adaptiveStep = False
     ti.automaticStepSize = False
     ti.verboseMode = 0
-    ti.newton.relativeTolerance = 1e-8
+    ti.newton.relativeTolerance = a.reltol
     ti.newton.absoluteTolerance = a.abstol or opt["abstol"]
     ti.newton.useModifiedNewton = True
     ti.computeLoadsJacobian = 2 if a.scene == "pendulum" else 0
