@@ -4,59 +4,32 @@
 //! The state is behind a mutex taken with `try_lock`: a second thread using the same
 //! Simulation while a step runs gets a `SimulationError`, never a data race.
 
+mod drive;
+mod inputs;
+mod saved;
+mod state;
+
 use crate::deck::{Deck, finite};
-use crate::law::PyLaw;
 use crate::overrides::{self, Overrides};
-use crate::poll::{self, Pending};
+use crate::poll::Pending;
 use crate::run::{RunData, end_time};
 use crate::{MecanoError, SimulationError};
-use mecano::app::memory::{self, Recording};
-use mecano::checkpoint::{self, Checkpoint};
-use mecano::elements::NodeState;
-use mecano::model::control::{Actuator, ControlData, ControlLaw, HeldValue, Sensor};
-use mecano::model::{ElementId, Model, NodeId};
-use mecano::output::Recorder;
-use mecano::solver::{self, Integrator, RunError, StepOutcome, Stepper};
+use inputs::check_axis;
+use mecano::checkpoint;
+use mecano::model::ElementId;
+use mecano::model::control::Sensor;
+use mecano::solver::StepOutcome;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use state::{Inner, Input, sensor};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
-/// An input added by `add_input`.
-struct Input {
-    id: u32,
-    /// Its value when held (set between steps, or by an explicit law).
-    held: Option<Arc<HeldValue>>,
-    /// A law called before each step with `(t, sim)` (tangent "explicit").
-    explicit: Option<Py<PyAny>>,
-}
-
-/// An explicit law to call before a step: its input, the callable, the value it sets.
-type ExplicitLaw = (u32, Py<PyAny>, Arc<HeldValue>);
-
 /// A 3-vector handed to Python.
 type Vector<'py> = Bound<'py, PyArray1<f64>>;
-
-/// A started run.
-struct Running {
-    integ: Integrator,
-    stepper: Stepper,
-    rec: Recorder,
-}
-
-struct Inner {
-    deck: Deck,
-    model: Model,
-    inputs: Vec<Input>,
-    run: Option<Running>,
-    /// Why the simulation cannot go on.
-    failed: Option<String>,
-    /// Values set on the deck's loads and drivers.
-    overrides: Overrides,
-}
 
 /// A simulation of a deck you advance yourself (see the Python docstrings in mecano/).
 #[pyclass(module = "mecano", frozen, subclass)]
@@ -78,112 +51,8 @@ fn busy() -> PyErr {
     )
 }
 
-/// A sensor from its Python form: `("angle" | "rate", hinge)` or
-/// `("x" | "y" | "z" | "vx" | "vy" | "vz", node)`.
-fn sensor_of(obj: &Bound<'_, PyAny>) -> PyResult<Sensor> {
-    let bad = || {
-        PyTypeError::new_err(format!(
-            "a sensor is ('angle'|'rate', hinge) or ('x'|'y'|'z'|'vx'|'vy'|'vz', node), not {}",
-            obj.repr().map(|r| r.to_string()).unwrap_or_default()
-        ))
-    };
-    let (kind, id): (String, u32) = obj.extract().map_err(|_| bad())?;
-    Ok(match kind.as_str() {
-        "angle" => Sensor::HingeAngle(ElementId(id)),
-        "rate" => Sensor::HingeRate(ElementId(id)),
-        "x" | "y" | "z" => Sensor::Coordinate(NodeId(id), axis_of(&kind)),
-        "vx" | "vy" | "vz" => Sensor::Velocity(NodeId(id), axis_of(&kind[1..])),
-        _ => return Err(bad()),
-    })
-}
-
-fn axis_of(s: &str) -> usize {
-    match s {
-        "x" => 0,
-        "y" => 1,
-        _ => 2,
-    }
-}
-
-fn check_axis(a: usize) -> PyResult<usize> {
-    if a < 3 {
-        Ok(a)
-    } else {
-        Err(PyValueError::new_err(format!("axis {a} is not 0, 1 or 2")))
-    }
-}
-
 fn v3<'py>(py: Python<'py>, v: &nalgebra::Vector3<f64>) -> Bound<'py, PyArray1<f64>> {
     vec![v.x, v.y, v.z].into_pyarray(py)
-}
-
-impl Inner {
-    fn usable(&self) -> PyResult<()> {
-        match &self.failed {
-            Some(why) => Err(SimulationError::new_err(format!(
-                "this Simulation failed and cannot go on: {why} (its histories up to the failure: sim.run())"
-            ))),
-            None => Ok(()),
-        }
-    }
-
-    /// Starts the run (the inputs are then fixed) unless it is under way.
-    fn start(&mut self, abort: &Arc<AtomicBool>) -> PyResult<&mut Running> {
-        if self.run.is_none() {
-            let mut integ = solver::prepare(&self.model)
-                .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.deck.name)))?;
-            integ.abort = Some(abort.clone());
-            let mut rec = recorder(self, &integ);
-            let none = mecano::interrupt::Interrupts::none();
-            let stepper = Stepper::start(
-                &self.model,
-                &mut integ,
-                &mut Recording {
-                    rec: &mut rec,
-                    interrupts: &none,
-                },
-                None,
-            )
-            .map_err(|e| MecanoError::new_err(e.to_string()))?;
-            self.run = Some(Running {
-                integ,
-                stepper,
-                rec,
-            });
-        }
-        Ok(self.run.as_mut().expect("started"))
-    }
-
-    fn running(&self) -> PyResult<&Running> {
-        self.run
-            .as_ref()
-            .ok_or_else(|| SimulationError::new_err("not started"))
-    }
-
-    fn node(&self, id: u32) -> PyResult<(usize, NodeState, nalgebra::Vector3<f64>)> {
-        let r = self.running()?;
-        let i = self.model.nodes.get_index_of(&NodeId(id)).ok_or_else(|| {
-            PyKeyError::new_err(format!("node {id} does not exist in {}", self.deck.name))
-        })?;
-        Ok((i, r.integ.nodes[i], r.integ.sys.x0[i]))
-    }
-
-    fn element_row(&self, id: u32) -> PyResult<(Vec<String>, Vec<f64>)> {
-        let r = self.running()?;
-        let e = self
-            .model
-            .elements
-            .get_index_of(&ElementId(id))
-            .ok_or_else(|| {
-                PyKeyError::new_err(format!("element {id} does not exist in {}", self.deck.name))
-            })?;
-        let integ = &r.integ;
-        let el = &integ.sys.elements[e];
-        let reported = integ.reported_multipliers();
-        let lam = integ.sys.element_lambda(e, &reported);
-        let row = el.output_row(&integ.current_context(), &integ.nodes, lam);
-        Ok((el.output_header(), row))
-    }
 }
 
 impl Simulation {
@@ -210,147 +79,6 @@ impl Simulation {
             abort: Arc::new(AtomicBool::new(false)),
             in_law: AtomicBool::new(false),
         }
-    }
-
-    /// Calls the explicit laws with `(t, sim)` and holds their values over the next step.
-    fn explicit_laws(slf: &Bound<'_, Self>) -> PyResult<()> {
-        let this = slf.get();
-        let (laws, t): (Vec<ExplicitLaw>, f64) = {
-            let inner = this.lock()?;
-            // A failed simulation says so before any law is called again.
-            inner.usable()?;
-            let laws = inner
-                .inputs
-                .iter()
-                .filter_map(|i| {
-                    Some((
-                        i.id,
-                        i.explicit.as_ref()?.clone_ref(slf.py()),
-                        i.held.clone()?,
-                    ))
-                })
-                .collect();
-            (laws, inner.run.as_ref().map_or(0.0, |r| r.integ.t))
-        };
-        let mut changed = false;
-        for (id, f, held) in laws {
-            this.in_law.store(true, Ordering::SeqCst);
-            let r = f.call1(slf.py(), (t, slf));
-            this.in_law.store(false, Ordering::SeqCst);
-            let fail = |e: PyErr| -> PyErr {
-                // Ctrl-C in the law, between steps: the simulation stops there, usable.
-                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(slf.py()) {
-                    return e;
-                }
-                if let Ok(mut inner) = this.lock() {
-                    inner.failed = Some(format!("the law of input {id} raised at t = {t} s"));
-                }
-                e
-            };
-            let r = r.map_err(fail)?;
-            let v: f64 = r.extract(slf.py()).map_err(|_| {
-                fail(PyTypeError::new_err(format!(
-                    "the law of input {id} returned {}, not a number",
-                    r.bind(slf.py())
-                        .repr()
-                        .map(|x| x.to_string())
-                        .unwrap_or_default()
-                )))
-            })?;
-            if !v.is_finite() {
-                return Err(fail(PyValueError::new_err(format!(
-                    "the law of input {id} returned {v} at t = {t} s"
-                ))));
-            }
-            changed |= held.get() != v;
-            held.set(v);
-        }
-        // Before the first step the initial accelerations were computed with the inputs'
-        // `value`: recomputed with the laws' values at t = 0, so the first step starts
-        // from the equations of motion it integrates (the arm held at rest by its law
-        // stays at rest), and the t = 0 row is recorded again with them.
-        if changed {
-            let mut inner = this.lock()?;
-            if let Some(r) = inner.run.as_mut()
-                && r.integ.stats.steps == 0
-                && r.integ.t == 0.0
-            {
-                overrides::restart(&mut r.integ, &mut r.rec)?;
-            }
-        }
-        Ok(())
-    }
-
-    /// Runs `go` on the started run with the GIL released and Ctrl-C polled; turns what
-    /// stopped it into Python's exception.
-    fn drive<F>(slf: &Bound<'_, Self>, go: F) -> PyResult<StepOutcome>
-    where
-        F: FnOnce(&mut Stepper, &mut Integrator, &mut Recording) -> Result<StepOutcome, RunError>
-            + Send,
-    {
-        let py = slf.py();
-        let this = slf.get();
-        if this.in_law.load(Ordering::SeqCst) {
-            return Err(busy());
-        }
-        let mut inner = this.lock()?;
-        inner.usable()?;
-        let end = inner
-            .run
-            .as_ref()
-            .map_or(end_time(&inner.model), |r| r.stepper.end);
-        let (interrupts, stop) = poll::interrupts(None, end, Some(this.ctrl_c.clone()));
-        let inner_ref: &mut Inner = &mut inner;
-        inner_ref.start(&this.abort)?;
-        let run = inner_ref.run.as_mut().expect("started");
-        let result = py.detach(|| {
-            let Running {
-                integ,
-                stepper,
-                rec,
-            } = run;
-            let mut obs = Recording {
-                rec,
-                interrupts: &interrupts,
-            };
-            go(stepper, integ, &mut obs)
-        });
-        let law_error = poll::take(&this.pending);
-        // Ctrl-C caught by a law in the last step (if the pauses did not see it).
-        let ctrl_c = poll::take(&this.ctrl_c);
-        let t = run.integ.t;
-        if let Some(e) = law_error {
-            inner.failed = Some(format!("a law raised at t = {t} s: {e}"));
-            return Err(e);
-        }
-        let outcome = match result {
-            Ok(o) => o,
-            Err(e) => {
-                inner.failed = Some(e.to_string());
-                return Err(MecanoError::new_err(e.to_string()));
-            }
-        };
-        // A step that failed is a failure, whatever Ctrl-C a law caught in it.
-        let ctrl_c = ctrl_c.filter(|_| outcome != StepOutcome::Failed);
-        if let Some(e) = poll::take(&stop).or(ctrl_c) {
-            // Ctrl-C: stopped at the end of a step; the simulation can go on.
-            if let Some(r) = inner.run.as_mut() {
-                r.stepper.clear_stop();
-            }
-            return Err(e);
-        }
-        if outcome == StepOutcome::Failed {
-            let msg = inner
-                .run
-                .as_ref()
-                .and_then(|r| r.stepper.failure().map(|f| f.to_string()))
-                .unwrap_or_default();
-            inner.failed = Some(msg.clone());
-            return Err(MecanoError::new_err(format!(
-                "the step failed: {msg}\n(histories up to t = {t} s are kept: sim.run())"
-            )));
-        }
-        Ok(outcome)
     }
 }
 
@@ -382,95 +110,7 @@ impl Simulation {
         sensors: Option<Vec<Bound<'_, PyAny>>>,
         tangent: &str,
     ) -> PyResult<u32> {
-        let mut inner = self.lock()?;
-        if inner.run.is_some() {
-            return Err(SimulationError::new_err(
-                "inputs are added before the simulation starts (its first step or state query)",
-            ));
-        }
-        finite("value", value)?;
-        let actuator = match (hinge, node, axis) {
-            (Some(h), None, None) => Actuator::HingeTorque(ElementId(h)),
-            (None, Some(n), Some(a)) => Actuator::NodeForce(NodeId(n), check_axis(a)?),
-            (None, Some(_), None) => {
-                return Err(PyValueError::new_err(
-                    "a force on a node needs its axis (0, 1, 2)",
-                ));
-            }
-            _ => {
-                return Err(PyValueError::new_err(
-                    "an input acts on a hinge (hinge=) or on a node along an axis (node=, axis=)",
-                ));
-            }
-        };
-        let sensors: Vec<Sensor> = sensors
-            .unwrap_or_default()
-            .iter()
-            .map(sensor_of)
-            .collect::<PyResult<_>>()?;
-        let id = inner.model.elements.keys().map(|k| k.0).max().unwrap_or(0) + 1;
-        let mut input = Input {
-            id,
-            held: None,
-            explicit: None,
-        };
-        let law_kind = match law {
-            None => {
-                let h = HeldValue::new(value);
-                input.held = Some(h.clone());
-                ControlLaw::Held(h)
-            }
-            Some(f) => {
-                Python::attach(|py| {
-                    if f.bind(py).is_callable() {
-                        Ok(())
-                    } else {
-                        Err(PyTypeError::new_err("law must be a callable of (t, sim)"))
-                    }
-                })?;
-                match tangent {
-                    "explicit" => {
-                        let h = HeldValue::new(value);
-                        input.held = Some(h.clone());
-                        input.explicit = Some(f);
-                        ControlLaw::Held(h)
-                    }
-                    "differentiated" => {
-                        if sensors.is_empty() {
-                            return Err(PyValueError::new_err(
-                                "a differentiated law names the sensors it reads: sensors=[('angle', 3), ('rate', 3)]",
-                            ));
-                        }
-                        ControlLaw::External(Arc::new(PyLaw {
-                            f,
-                            sensors: Arc::new(sensors.clone()),
-                            input: id,
-                            pending: self.pending.clone(),
-                            abort: self.abort.clone(),
-                            interrupt: self.ctrl_c.clone(),
-                        }))
-                    }
-                    other => {
-                        return Err(PyValueError::new_err(format!(
-                            "tangent is 'differentiated' or 'explicit', not {other:?}"
-                        )));
-                    }
-                }
-            }
-        };
-        inner
-            .model
-            .add_control(
-                ElementId(id),
-                ControlData {
-                    actuator,
-                    sensors,
-                    law: law_kind,
-                },
-            )
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        inner.inputs.push(input);
-        Ok(id)
+        self.add_input_to(hinge, node, axis, value, law, sensors, tangent)
     }
 
     /// Sets a held input's value (N·m or N), used from the next step on; in a started
@@ -752,50 +392,7 @@ impl Simulation {
 
     /// Writes the state to `dir`/checkpoint.bin (the checkpoint format of mecano-rs).
     fn save(slf: &Bound<'_, Self>, dir: PathBuf) -> PyResult<()> {
-        let this = slf.get();
-        let mut inner = this.lock()?;
-        inner.usable()?;
-        let deck = inner.deck.clone();
-        let r = inner.start(&this.abort)?;
-        let integrator = r
-            .integ
-            .save_state()
-            .map_err(|e| MecanoError::new_err(e.to_string()))?;
-        let id = mecano::app::deck_identity(
-            deck.path
-                .as_deref()
-                .unwrap_or(std::path::Path::new(&deck.name)),
-            &deck.text,
-            &deck.set,
-            deck.refine,
-        );
-        let c = Checkpoint {
-            program: format!("mecano (Python) {}", env!("CARGO_PKG_VERSION")),
-            deck: mecano::checkpoint::DeckIdentity {
-                path: deck.name.clone(),
-                ..id
-            },
-            time: r.integ.t,
-            step: r.integ.stats.steps,
-            control: r.stepper.control(),
-            integrator,
-            writer: Default::default(),
-            vtk: None,
-        };
-        let held: Vec<(u32, f64)> = inner
-            .inputs
-            .iter()
-            .filter(|i| i.explicit.is_none())
-            .filter_map(|i| Some((i.id, i.held.as_ref()?.get())))
-            .collect();
-        let record = inner.overrides.record(c.time, c.step, &held);
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| MecanoError::new_err(format!("{}: {e}", dir.display())))?;
-        // The values set from Python first: a checkpoint left without its record would be
-        // refused at load by the record's time, never restored without them.
-        overrides::write(&dir, &record)?;
-        checkpoint::write(&dir, &c, 1)
-            .map_err(|e| MecanoError::new_err(format!("{}: {e}", dir.display())))
+        Self::save_to(slf, dir)
     }
 
     /// A simulation restored from `dir`/checkpoint.bin (its deck read again from where it
@@ -807,34 +404,7 @@ impl Simulation {
         dir: PathBuf,
         deck: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let py = cls.py();
-        let c = checkpoint::read(&dir).map_err(|e| MecanoError::new_err(e.to_string()))?;
-        let deck = match deck {
-            Some(d) => Deck::of(d)?,
-            None => {
-                let path = c
-                    .deck
-                    .absolute
-                    .clone()
-                    .unwrap_or_else(|| c.deck.path.clone());
-                Deck::of(&pyo3::types::PyString::new(py, &path).into_any())?
-            }
-        };
-        let deck = if deck.set != c.deck.set || deck.refine != c.deck.refine.max(1) {
-            Deck::parse(
-                py,
-                deck.text,
-                deck.name,
-                deck.path,
-                c.deck.set.clone(),
-                c.deck.refine,
-            )?
-        } else {
-            deck
-        };
-        let sim = cls.call1((Py::new(py, deck)?,))?;
-        sim.cast::<Simulation>()?.get().restore_from(c, &dir)?;
-        Ok(sim)
+        Self::load_from(cls, dir, deck)
     }
 
     /// Restores this (not yet started) simulation from `dir`/checkpoint.bin: for a
@@ -857,112 +427,10 @@ impl Simulation {
     }
 }
 
-impl Simulation {
-    fn restore_from(&self, c: Checkpoint, dir: &std::path::Path) -> PyResult<()> {
-        let saved = overrides::read(dir, c.time, c.step)?;
-        let mut inner = self.lock()?;
-        if inner.run.is_some() {
-            return Err(SimulationError::new_err(
-                "restore() is for a simulation not yet started",
-            ));
-        }
-        let sha = mecano::checkpoint::sha256_hex(inner.deck.text.as_bytes());
-        if sha != c.deck.sha256 {
-            return Err(MecanoError::new_err(format!(
-                "the checkpoint belongs to another deck text than {} (SHA-256 {} vs {})",
-                inner.deck.name, c.deck.sha256, sha
-            )));
-        }
-        let mut integ =
-            solver::prepare(&inner.model).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        integ.abort = Some(self.abort.clone());
-        integ.restore_state(c.integrator).map_err(|e| {
-            MecanoError::new_err(format!(
-                "{e} (a simulation saved with inputs is restored by one with the same inputs: add them, then sim.restore(dir))"
-            ))
-        })?;
-        let mut rec = recorder(&inner, &integ);
-        let none = mecano::interrupt::Interrupts::none();
-        let stepper = Stepper::start(
-            &inner.model,
-            &mut integ,
-            &mut Recording {
-                rec: &mut rec,
-                interrupts: &none,
-            },
-            Some(c.control),
-        )
-        .map_err(|e| MecanoError::new_err(e.to_string()))?;
-        if let Some(saved) = saved {
-            let inner: &mut Inner = &mut inner;
-            inner.overrides.restore(&inner.model, &mut integ, &saved)?;
-            for (id, v) in saved.inputs {
-                match inner.inputs.iter().find(|i| i.id == id) {
-                    Some(Input {
-                        held: Some(h),
-                        explicit: None,
-                        ..
-                    }) => h.set(v),
-                    _ => {
-                        return Err(SimulationError::new_err(format!(
-                            "the checkpoint was saved with input {id} held at {v}: add the same inputs (add_input), then sim.restore(dir)"
-                        )));
-                    }
-                }
-            }
-        }
-        inner.run = Some(Running {
-            integ,
-            stepper,
-            rec,
-        });
-        Ok(())
-    }
-}
-
-/// The recorder of a Simulation's histories. With inputs, the summary's
-/// `step_resolution` block (modes about the initial state, `modes::run_summary`) is not
-/// computed: it would call the Python laws with the GIL held, and on
-/// decks/pd_flexible_arm.dat with a PD law the dense eigensolver of that block does not
-/// return (faer's real Schur; the CLI hangs the same way with a deck PID on that arm).
-fn recorder(inner: &Inner, integ: &Integrator) -> Recorder {
-    if inner.inputs.is_empty() {
-        return memory::recorder(&inner.model, &inner.deck.name, inner.deck.refine, integ);
-    }
-    let mut rec = Recorder::new(&inner.deck.name, &inner.model, &integ.sys);
-    rec.refine = inner.deck.refine.max(1);
-    rec.notes.insert(
-        mecano::modes::run_summary::KEY.into(),
-        serde_json::json!({
-            "computed": false,
-            "reason": "not computed: a Simulation with inputs (use mecano.modes on the deck)",
-        }),
-    );
-    rec
-}
-
 /// The simulation's state, started.
 fn started<'a>(slf: &'a Bound<'_, Simulation>) -> PyResult<MutexGuard<'a, Inner>> {
     let this = slf.get();
     let mut inner = this.lock()?;
     inner.start(&this.abort)?;
     Ok(inner)
-}
-
-fn sensor(inner: &Inner, s: Sensor, joint: u32) -> PyResult<f64> {
-    let r = inner.running()?;
-    if inner.model.hinge_nodes(ElementId(joint)).is_none() {
-        return Err(PyKeyError::new_err(format!(
-            "element {joint} is not a HINGE"
-        )));
-    }
-    if let Sensor::HingeAngle(_) = s {
-        // The joint's own angle, whole turns counted across steps.
-        let (h, row) = inner.element_row(joint)?;
-        if let Some(i) = h.iter().position(|c| c == "angle") {
-            return Ok(row[i]);
-        }
-    }
-    mecano::elements::control::read_sensor(&inner.model, &r.integ.nodes, s)
-        .ok_or_else(|| PyValueError::new_err(format!("hinge {joint} has no angle (torn apart)")))
 }
