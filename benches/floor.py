@@ -81,7 +81,12 @@ def main():
     a = ap.parse_args()
     if not os.access(BIN, os.X_OK):
         sys.exit(f"{BIN} missing: cargo build --release")
-    runs = [json.loads(line) for line in open(a.runs)] if a.runs else []
+    if a.rounds < 1 or not a.lead > 0:
+        sys.exit("--rounds must be at least 1 and --lead above 0")
+    try:
+        runs = [json.loads(line) for line in open(a.runs) if line.strip()] if a.runs else []
+    except (OSError, ValueError) as e:
+        sys.exit(f"--runs {a.runs}: {e}")
     rows = []
     with tempfile.TemporaryDirectory() as td:
         for arg in a.rungs:
