@@ -14,7 +14,7 @@ use crate::overrides::{self, Overrides};
 use crate::poll::Pending;
 use crate::run::{RunData, end_time};
 use crate::{MecanoError, SimulationError};
-use inputs::check_axis;
+use inputs::{InputRequest, check_axis};
 use mecano::checkpoint;
 use mecano::model::ElementId;
 use mecano::model::control::Sensor;
@@ -110,7 +110,16 @@ impl Simulation {
         sensors: Option<Vec<Bound<'_, PyAny>>>,
         tangent: &str,
     ) -> PyResult<u32> {
-        self.add_input_to(hinge, node, axis, value, law, sensors, tangent)
+        let request = InputRequest {
+            hinge,
+            node,
+            axis,
+            value,
+            law,
+            sensors,
+            tangent,
+        };
+        self.add_input_to(request)
     }
 
     /// Sets a held input's value (N·m or N), used from the next step on; in a started

@@ -49,20 +49,21 @@ pub(super) fn check_axis(a: usize) -> PyResult<usize> {
     }
 }
 
+/// `Simulation.add_input`'s keyword arguments, as Python gave them (its docstring: mecano/).
+pub(super) struct InputRequest<'a, 'py> {
+    pub(super) hinge: Option<u32>,
+    pub(super) node: Option<u32>,
+    pub(super) axis: Option<usize>,
+    pub(super) value: f64,
+    pub(super) law: Option<Py<PyAny>>,
+    pub(super) sensors: Option<Vec<Bound<'py, PyAny>>>,
+    pub(super) tangent: &'a str,
+}
+
 impl Simulation {
-    /// `Simulation.add_input` (its docstring: mecano/), whose keyword arguments these are,
-    /// one for one.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn add_input_to(
-        &self,
-        hinge: Option<u32>,
-        node: Option<u32>,
-        axis: Option<usize>,
-        value: f64,
-        law: Option<Py<PyAny>>,
-        sensors: Option<Vec<Bound<'_, PyAny>>>,
-        tangent: &str,
-    ) -> PyResult<u32> {
+    /// `Simulation.add_input`: the input's element number.
+    pub(super) fn add_input_to(&self, r: InputRequest<'_, '_>) -> PyResult<u32> {
+        let value = r.value;
         let mut inner = self.lock()?;
         if inner.run.is_some() {
             return Err(SimulationError::new_err(
@@ -70,7 +71,7 @@ impl Simulation {
             ));
         }
         finite("value", value)?;
-        let actuator = match (hinge, node, axis) {
+        let actuator = match (r.hinge, r.node, r.axis) {
             (Some(h), None, None) => Actuator::HingeTorque(ElementId(h)),
             (None, Some(n), Some(a)) => Actuator::NodeForce(NodeId(n), check_axis(a)?),
             (None, Some(_), None) => {
@@ -84,7 +85,8 @@ impl Simulation {
                 ));
             }
         };
-        let sensors: Vec<Sensor> = sensors
+        let sensors: Vec<Sensor> = r
+            .sensors
             .unwrap_or_default()
             .iter()
             .map(sensor_of)
@@ -95,7 +97,7 @@ impl Simulation {
             held: None,
             explicit: None,
         };
-        let law_kind = match law {
+        let law_kind = match r.law {
             None => {
                 let h = HeldValue::new(value);
                 input.held = Some(h.clone());
@@ -109,7 +111,7 @@ impl Simulation {
                         Err(PyTypeError::new_err("law must be a callable of (t, sim)"))
                     }
                 })?;
-                match tangent {
+                match r.tangent {
                     "explicit" => {
                         let h = HeldValue::new(value);
                         input.held = Some(h.clone());

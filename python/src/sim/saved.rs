@@ -2,13 +2,12 @@
 //! format with the values set from Python beside it, and a simulation restored from them.
 
 use super::Simulation;
-use super::state::{Inner, Input, Running, recorder};
+use super::state::{Inner, Input};
 use crate::deck::Deck;
 use crate::overrides;
 use crate::{MecanoError, SimulationError};
-use mecano::app::memory::Recording;
 use mecano::checkpoint::{self, Checkpoint};
-use mecano::solver::{self, Stepper};
+use mecano::solver;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -121,21 +120,12 @@ impl Simulation {
                 "{e} (a simulation saved with inputs is restored by one with the same inputs: add them, then sim.restore(dir))"
             ))
         })?;
-        let mut rec = recorder(&inner, &integ);
-        let none = mecano::interrupt::Interrupts::none();
-        let stepper = Stepper::start(
-            &inner.model,
-            &mut integ,
-            &mut Recording {
-                rec: &mut rec,
-                interrupts: &none,
-            },
-            Some(c.control),
-        )
-        .map_err(|e| MecanoError::new_err(e.to_string()))?;
+        let mut run = inner.running_from(integ, Some(c.control))?;
         if let Some(saved) = saved {
             let inner: &mut Inner = &mut inner;
-            inner.overrides.restore(&inner.model, &mut integ, &saved)?;
+            inner
+                .overrides
+                .restore(&inner.model, &mut run.integ, &saved)?;
             for (id, v) in saved.inputs {
                 match inner.inputs.iter().find(|i| i.id == id) {
                     Some(Input {
@@ -151,11 +141,7 @@ impl Simulation {
                 }
             }
         }
-        inner.run = Some(Running {
-            integ,
-            stepper,
-            rec,
-        });
+        inner.run = Some(run);
         Ok(())
     }
 }

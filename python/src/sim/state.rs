@@ -10,7 +10,7 @@ use mecano::elements::NodeState;
 use mecano::model::control::{HeldValue, Sensor};
 use mecano::model::{ElementId, Model, NodeId};
 use mecano::output::Recorder;
-use mecano::solver::{self, Integrator, Stepper};
+use mecano::solver::{self, Integrator, LoopState, Stepper};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use std::sync::Arc;
@@ -62,25 +62,35 @@ impl Inner {
             let mut integ = solver::prepare(&self.model)
                 .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.deck.name)))?;
             integ.abort = Some(abort.clone());
-            let mut rec = recorder(self, &integ);
-            let none = mecano::interrupt::Interrupts::none();
-            let stepper = Stepper::start(
-                &self.model,
-                &mut integ,
-                &mut Recording {
-                    rec: &mut rec,
-                    interrupts: &none,
-                },
-                None,
-            )
-            .map_err(|e| MecanoError::new_err(e.to_string()))?;
-            self.run = Some(Running {
-                integ,
-                stepper,
-                rec,
-            });
+            self.run = Some(self.running_from(integ, None)?);
         }
         Ok(self.run.as_mut().expect("started"))
+    }
+
+    /// The run of `integ` (prepared, or restored from a checkpoint with its step control
+    /// `resume`): its recorder, and its stepper at the first state (recorded).
+    pub(super) fn running_from(
+        &self,
+        mut integ: Integrator,
+        resume: Option<LoopState>,
+    ) -> PyResult<Running> {
+        let mut rec = recorder(self, &integ);
+        let none = mecano::interrupt::Interrupts::none();
+        let stepper = Stepper::start(
+            &self.model,
+            &mut integ,
+            &mut Recording {
+                rec: &mut rec,
+                interrupts: &none,
+            },
+            resume,
+        )
+        .map_err(|e| MecanoError::new_err(e.to_string()))?;
+        Ok(Running {
+            integ,
+            stepper,
+            rec,
+        })
     }
 
     pub(super) fn running(&self) -> PyResult<&Running> {
