@@ -102,7 +102,7 @@ fn sparse_lanczos_agrees_with_the_dense_solve_on_a_constrained_frame() {
     }
 }
 
-/// The Timoshenko frequencies of the cantilever with a 1 kg tip mass (tests/modes.rs).
+/// The Timoshenko frequencies of the cantilever with a 1 kg tip mass (tests/modes/main.rs).
 const TIMOSHENKO_HZ: [f64; 3] = [22.19447, 148.11007, 426.61513];
 
 #[test]
@@ -127,7 +127,7 @@ fn cantilever_frequencies_through_the_sparse_path() {
 
 #[test]
 fn free_free_beam_through_the_sparse_path_has_six_rigid_modes() {
-    // A free steel beam, 10 m, 4 elements of order 8 (tests/modes.rs's): the block of six
+    // A free steel beam, 10 m, 4 elements of order 8 (tests/modes/beams.rs's): the block of six
     // finds the six rigid motions (θ = 1/|σ|, ω² exact to ε|σ|), then the elastic modes as
     // the dense path does.
     let deck = "TITLE free-free beam
