@@ -1,6 +1,6 @@
 //! The third-order ESDIRK integrator (`ANALYSIS ... ESDIRK3`, `solver::integrator::esdirk`,
 //! issue 26 §2): its coefficients, its observed order on closed-form cases, and the
-//! stability suite's cases (tests/stability.rs) run with it. The tests print what they
+//! stability suite's cases (tests/stability/) run with it. The tests print what they
 //! measure (`-- --nocapture`); docs/accuracy.md ("A third-order integrator") records it.
 
 mod common;
@@ -202,7 +202,7 @@ fn third_order_on_the_free_rigid_body() {
 /// through the torque pulse and the first impact (0.6 s): no failure, the constraints held,
 /// and the energy balance never rises above its start by more than its own quadrature's
 /// error ([`quadrature_bound`]) plus 1e-6 of the largest kinetic energy (the Newton
-/// tolerance's work, as in tests/stability.rs).
+/// tolerance's work, as in tests/stability/stiff.rs).
 #[test]
 fn stiff_bars_and_the_impact_run_and_never_create_energy() {
     for (scheme, d) in SCHEMES
@@ -399,7 +399,7 @@ fn long_runs_stay_bounded_with(scheme: Scheme) {
     // While the torque pulse acts (t ≤ 0.02 s) the balance's trapezoidal work of the pulse
     // errs by up to `quadrature_bound`; after it only gravity acts, which the balance holds
     // exactly (its potential is in E), so from there on no rise at all beyond Newton's
-    // tolerance (1e-6 of the largest kinetic energy, as in tests/stability.rs).
+    // tolerance (1e-6 of the largest kinetic energy, as in tests/stability/stiff.rs).
     let after = rec
         .t
         .iter()
@@ -574,7 +574,7 @@ fn esdirk5_restitution_is_accurate_through_the_unclipped_contact() {
 /// 5e-4 and 1e-4 s. With the ends alone a 5e-4 s step's stages sat in the contact that both
 /// ends were clear of: ESDIRK3 reached 6.9e-5 m of penetration instead of 1.8e-4 m and kept
 /// 0.3 J of 5 J, and ESDIRK5 at 1e-3 s created 33 J. Asserted, as
-/// `clearance_joint_hard_impact_over_the_step_range` in tests/stability.rs does for HHT: no
+/// `clearance_joint_hard_impact_over_the_step_range` in tests/stability/clearance.rs does for HHT: no
 /// energy created (the balance `E − W_ext + W_damp` above its start by no more than 1e-6 of
 /// the initial 12.5 J plus the trapezoidal error of the contact's dissipated work,
 /// [`quadrature_bound`]: measured 3.1e-3 J for ESDIRK3 at 1e-3 s), and the deepest penetration within

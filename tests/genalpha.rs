@@ -93,7 +93,7 @@ fn closed_form_limits_and_the_modes_table_agree() {
 /// The spring–mass of `decks/stab_spring_mass.dat` (ω = 100 rad/s, exactly linear) run
 /// with GENALPHA: its measured spectral radius and period match the closed form above.
 ///
-/// **Measured** as the HHT test of `tests/stability.rs` does: ρ from the energy
+/// **Measured** as the HHT test of `tests/stability/damping.rs` does: ρ from the energy
 /// `½(v² + ω²x²)` at the first and last upward zero crossings over 20 periods,
 /// `(E_N/E_0)^{1/(2n)}`, n the steps between them; the period from the mean spacing of
 /// the crossings (linear interpolation). The tolerances are that test's, set by the

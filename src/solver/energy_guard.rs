@@ -66,7 +66,7 @@
 //! the summed bound) or goes on and says so (above the ceiling only). A
 //! spurious Newton root (1e5 J from 179 J, issue 28) fails it by orders of magnitude; so
 //! does the burst of issue 35 (66 J created in 2 ms on the seed's scene); a run the steps
-//! resolve never comes near it (`tests/stability.rs`).
+//! resolve never comes near it (`tests/stability/`).
 
 pub mod bound;
 

@@ -1,6 +1,6 @@
 //! The 1-D impact of a mass on a compliant wall, `m δ̈ = −max(F(δ, δ̇), 0)` from `δ = 0`,
 //! `δ̇ = v₀`, integrated by RK4: the independent route the clearance joint's tests check
-//! their impacts against (tests/mechanics/clearance.rs, tests/stability.rs).
+//! their impacts against (tests/mechanics/clearance.rs, tests/stability/clearance.rs).
 
 /// RK4 with `n` steps over `t_est` (an estimate of the impact's duration) until the
 /// penetration closes again: `(rebound speed / v₀, deepest penetration)`.

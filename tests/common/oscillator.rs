@@ -1,5 +1,5 @@
 //! What a run of a linear oscillator measures of its integrator: the spectral radius and
-//! the relative period error, against their closed forms (tests/stability.rs for HHT,
+//! the relative period error, against their closed forms (tests/stability/damping.rs for HHT,
 //! tests/genalpha.rs for generalized-α).
 
 /// From the sampled displacement `x` and velocity `v` of an oscillator of circular

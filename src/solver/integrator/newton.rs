@@ -319,9 +319,9 @@ impl Integrator {
             // needs no extra iteration to show it. (The increment bound alone is not enough:
             // an error δu is δu/(γh)² in the accelerations, and without the residual bound the
             // simple pendulum's hinge reaction at h = 1e-5 s was 1.0e-3 off, 16 times its
-            // round-off bound, `tests/stability.rs`.) Not for the α family: tried in issue 37
+            // round-off bound, `tests/stability/stiff.rs`.) Not for the α family: tried in issue 37
             // (−7 % of the cantilever's CPU), it left the simple pendulum's hinge reaction at
-            // h = 1e-6 s 4.5e-2 off, twice its round-off bound (`tests/stability.rs`,
+            // h = 1e-6 s 4.5e-2 off, twice its round-off bound (`tests/stability/stiff.rs`,
             // `step_range_keeps_iterations_and_multipliers`): HHT's index-3 multipliers need
             // the polishing the stages' velocity-level rows do not.
             let rho = rel / prev_rel;
