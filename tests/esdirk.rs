@@ -135,7 +135,7 @@ fn assert_order(what: &str, e: &[f64], p: f64) {
     assert!((limit - p).abs() <= 0.2, "{what}: slope limit {limit}");
 }
 
-/// Runge–Kutta 4 on `θ'' = −(g/L) cos θ` (the simple pendulum, tests/joints.rs): at
+/// Runge–Kutta 4 on `θ'' = −(g/L) cos θ` (the simple pendulum, tests/joints/planar.rs): at
 /// dt = 1e-4 s its error over 2 s is ~1e-13 rad (h⁴ scaling from the 1e-3 run), far below
 /// the errors measured here (≥ 4e-8 m).
 fn pendulum_angle(t_end: f64) -> f64 {

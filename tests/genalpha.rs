@@ -1,7 +1,7 @@
 //! Generalized-α on the Lie group (issue 26 §1): its spectral properties on the linear
 //! oscillator against the closed form, energy conservation at ρ∞ = 1, second-order
 //! convergence on a nonlinear rigid body. (The rigid double pendulum against its Lagrange
-//! equations is in `tests/joints.rs`, the pre-impact order of the flexible pendulum in
+//! equations is in `tests/joints/planar.rs`, the pre-impact order of the flexible pendulum in
 //! `tests/accuracy.rs`, restarts in `tests/restart_state.rs`, with the HHT cases.)
 
 mod common;

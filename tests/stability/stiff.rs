@@ -174,7 +174,7 @@ fn stiff_contact_runs_and_never_creates_energy() {
 ///
 /// (Runs that start with velocities get the constraints' velocity term Ḃv in their
 /// initial multipliers: see `launched_pendulum_starts_with_the_centripetal_tension` in
-/// tests/joints.rs.)
+/// tests/joints/spatial.rs.)
 #[test]
 fn step_range_keeps_iterations_and_multipliers() {
     const T_END: f64 = 0.05;
