@@ -630,10 +630,11 @@ def run_case(binary, root, seed, k, limit):
         # Slow or hung? A bounded loop hears SIGINT: the run ends at its next step (130),
         # --check and modes at once. Only a process that ignores it is a hang.
         p.send_signal(signal.SIGINT)
+        t_int = time.time()
         try:
             so, se = p.communicate(timeout=15)
             rc = p.returncode
-            case_note = f"slow: ended {rc} 15 s after SIGINT at {limit:.0f} s"
+            case_note = f"slow: ended {rc} {time.time() - t_int:.1f} s after SIGINT at {limit:.0f} s"
         except subprocess.TimeoutExpired:
             p.kill()
             so, se = p.communicate()
