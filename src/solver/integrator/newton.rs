@@ -323,7 +323,9 @@ impl Integrator {
             // (−7 % of the cantilever's CPU), it left the simple pendulum's hinge reaction at
             // h = 1e-6 s 4.5e-2 off, twice its round-off bound (`tests/stability/stiff.rs`,
             // `step_range_keeps_iterations_and_multipliers`): HHT's index-3 multipliers need
-            // the polishing the stages' velocity-level rows do not.
+            // the polishing the stages' velocity-level rows do not. (On a model without
+            // multipliers it left ten times the Newton error at the same tolerance, for the
+            // same work at equal error: docs/performance.md, "Tried and dropped".)
             let rho = rel / prev_rel;
             let contracted = kin == Kinematics::Stage
                 && rho < 0.5
