@@ -155,7 +155,9 @@ pub(super) fn solve_dense(
     // Round-off of Re s in the first-order form `A = [0 I; −M⁻¹K −M⁻¹C]`: the dense
     // eigen-solver is backward stable, `δA ~ ε‖A‖`, `‖A‖ ≈ max(1, ‖K‖/‖M‖, ‖C‖/‖M‖, ω²_max)`
     // (SI units of the assembly), and moves an eigenvalue by its condition number times
-    // that. For the undamped pair `s = ±iω` the right and left eigenvectors are `(φ, sφ)`
+    // that. (The solve balances `A`'s blocks, `dense::block_balance`: `‖A‖ ≈ ω_max` and
+    // the pair's condition `(σ² + |s|²)/(2σ|s|)`, whose product with it is at most the
+    // bound below, which stays an upper bound.) For the undamped pair `s = ±iω` the right and left eigenvectors are `(φ, sφ)`
     // and `(sφ, φ)`-like, condition `(1 + ω²)/(2ω)`; so `|δRe s| ≲ ε‖A‖(1 + |s|²)/(2|s|)`,
     // ZERO_FACTOR of it as for ω². Below it the sign of Re s is round-off: the mode is
     // neither damped nor unstable (the heavy top's ζ = −1.9e-15 at |s| = 4.75 1/s; the
