@@ -214,8 +214,8 @@ fn first_order(
 /// slider-crank of `benches/peers/`, moving at its start), and the unblocked QR left its
 /// lowest frequencies 1.9e-5–2.9e-5 relative off (131.91359 Hz where LAPACK's `dgeev`, which
 /// balances, gives 131.909827 on either form; balanced here: 131.909827, within 1e-10),
-/// in 22 % more instructions. Test: `gyroscopic_frequencies_over_four_decades_match_the_
-/// hermitian_route` (below: 1.6e-6 relative unbalanced, 9.5e-10 balanced).
+/// in 22 % more instructions. Test (below; 1.6e-6 relative unbalanced, 9.5e-10 balanced):
+/// `gyroscopic_frequencies_over_four_decades_match_the_hermitian_route`.
 fn block_balance(k_max: f64) -> f64 {
     if k_max.is_finite() && k_max > 0.0 {
         2f64.powi(k_max.sqrt().log2().round() as i32)
@@ -431,12 +431,12 @@ mod tests {
         let w: Vec<f64> = (0..n)
             .map(|i| 100.0 * 1e4f64.powf(i as f64 / (n - 1) as f64))
             .collect();
-        let k = &q
-            * DMatrix::from_fn(n, n, |i, j| if i == j { w[i] * w[i] } else { 0.0 })
-            * q.transpose();
+        let diag = |f: &dyn Fn(f64) -> f64| {
+            DMatrix::from_diagonal(&DVector::from_iterator(n, w.iter().map(|&x| f(x))))
+        };
+        let k = &q * diag(&|x| x * x) * q.transpose();
         let k = (&k + k.transpose()) * 0.5;
-        let k_half =
-            &q * DMatrix::from_fn(n, n, |i, j| if i == j { w[i] } else { 0.0 }) * q.transpose();
+        let k_half = &q * diag(&|x| x) * q.transpose();
         let g0 = DMatrix::from_fn(n, n, |_, _| 100.0 * rnd());
         let g = &g0 - g0.transpose();
         let t = DMatrix::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {

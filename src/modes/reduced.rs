@@ -157,8 +157,8 @@ pub(super) fn solve_dense(
     // (SI units of the assembly), and moves an eigenvalue by its condition number times
     // that. (The solve balances `A`'s blocks, `dense::block_balance`: `‖A‖ ≈ ω_max` and
     // the pair's condition `(σ² + |s|²)/(2σ|s|)`, whose product with it is at most the
-    // bound below, which stays an upper bound.) For the undamped pair `s = ±iω` the right and left eigenvectors are `(φ, sφ)`
-    // and `(sφ, φ)`-like, condition `(1 + ω²)/(2ω)`; so `|δRe s| ≲ ε‖A‖(1 + |s|²)/(2|s|)`,
+    // bound below, which stays an upper bound.) For the undamped pair `s = ±iω` the right
+    // and left eigenvectors are `(φ, sφ)` and `(sφ, φ)`-like, condition `(1 + ω²)/(2ω)`; so `|δRe s| ≲ ε‖A‖(1 + |s|²)/(2|s|)`,
     // ZERO_FACTOR of it as for ω². Below it the sign of Re s is round-off: the mode is
     // neither damped nor unstable (the heavy top's ζ = −1.9e-15 at |s| = 4.75 1/s; the
     // pendulum at 0.05 s: ζ = −2.6e-6 at |s| = 5.7 1/s with ω²_max = 9.4e10 1/s²).
