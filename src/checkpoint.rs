@@ -38,8 +38,9 @@ pub const TMP_NAME: &str = "checkpoint.bin.tmp";
 /// stage schemes' index-1 reaction solve's factors; 4: the guard's record holds the largest
 /// energies of the oscillations, since its running minimum and over the run; 5: and the
 /// energy created above its ceiling at the smallest step; 6: the nodes' orientations at the
-/// kept factorisation, whose co-rotated frames the next solve uses.)
-pub const FORMAT_VERSION: u32 = 6;
+/// kept factorisation, whose co-rotated frames the next solve uses; 7: the adaptive ESDIRK
+/// steps' drift filter, `CARRY MODES`.)
+pub const FORMAT_VERSION: u32 = 7;
 const MAGIC: &[u8; 8] = b"MECANOCK";
 
 /// The deck a run belongs to.
@@ -228,8 +229,8 @@ mod tests {
         d[k] ^= 0x10;
         assert!(why(&d).contains("checksum"));
         let mut v = b.clone();
-        v[8] = 7;
-        assert!(why(&v).contains("version 7"));
+        v[8] = 6;
+        assert!(why(&v).contains("version 6"));
         let mut m = b;
         m[0] = b'X';
         assert!(why(&m).contains("MECANOCK"));

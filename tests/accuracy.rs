@@ -25,6 +25,7 @@ fn configure(m: &mut Model, h: f64, hmax: f64, tol: Option<f64>) {
             tol_position: t,
             tol_rotation: t,
             max_growth: 2.0,
+            carry: Default::default(),
         });
     }
 }

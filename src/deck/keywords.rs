@@ -371,6 +371,16 @@ const ROWS: &[KeywordDoc] = &[
         "adaptive: largest step growth factor (>= 1, default 2)",
     ),
     kw(
+        "CARRY",
+        "ANALYSIS",
+        "adaptive ESDIRK: how a step's velocity error counts, RUN (END x |e_v|, default) or MODES (by the linearised modes)",
+    ),
+    kw(
+        "RUN",
+        "ANALYSIS",
+        "CARRY RUN: a velocity error counts for the run's length (default)",
+    ),
+    kw(
         "TOL",
         "ANALYSIS",
         "Newton residual tolerance (> 0, default 1e-8)",

@@ -255,6 +255,9 @@ pub fn write_deck(model: &Model) -> String {
                     " ADAPTIVE TOLPOS {:?} TOLROT {:?} GROWTH {:?}",
                     a.tol_position, a.tol_rotation, a.max_growth
                 );
+                if a.carry == crate::model::Carry::Modes {
+                    s.push_str(" CARRY MODES");
+                }
             }
             let _ = writeln!(
                 s,

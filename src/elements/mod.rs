@@ -482,6 +482,14 @@ pub trait Element: Send + Sync {
         RotationUse::AsEvaluated
     }
 
+    /// Whether its forces come and go with events (a contact: touch and release), so that
+    /// the linearised model about one state says nothing of the run after the next event:
+    /// the adaptive steps' drift filter leaves such elements out
+    /// (`solver::integrator::drift`). Default: no.
+    fn intermittent(&self) -> bool {
+        false
+    }
+
     /// Event (impact) control of a converged trial step from `old` to `new` (step
     /// `ctx.h`), asked before the step is committed. `None` = no opinion (the default).
     /// The integrator refuses the step when `ctx.h > accept_up_to` (and retries with

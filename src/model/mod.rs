@@ -350,6 +350,23 @@ pub struct Adaptive {
     pub tol_rotation: f64,
     /// Largest step growth factor per step (default 2).
     pub max_growth: f64,
+    /// How the ESDIRK schemes' embedded velocity error counts as a position error
+    /// (`CARRY`; the α family's estimate has no velocity term).
+    pub carry: Carry,
+}
+
+/// How far an adaptive ESDIRK step's velocity error `e_v` is taken to carry the positions
+/// by the run's end `T` (`ANALYSIS … ADAPTIVE … CARRY RUN|MODES`, docs/accuracy.md,
+/// "Accuracy asked for").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Carry {
+    /// `T |e_v|`, as if it were a drift, whatever it is: the default, conservative (the
+    /// errors measured 1e-3 … 1e-2 of the tolerance on flexible models).
+    #[default]
+    Run,
+    /// By the linearised model's modes: `T |e_v|` for a drift, `|e_v|/ω` for a vibration
+    /// of frequency `ω` (`solver::integrator::drift`).
+    Modes,
 }
 
 /// The analysis to run.

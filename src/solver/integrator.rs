@@ -227,6 +227,9 @@ pub struct Integrator {
     /// The index-1 solve of a stage scheme's accelerations and multipliers at each step's
     /// end ([`multipliers`]); `None` for the α family and for models without multipliers.
     index1: Option<Box<multipliers::Index1>>,
+    /// The adaptive ESDIRK steps' filter of their velocity error ([`drift`]), built at
+    /// their first estimate.
+    drift: Option<Box<drift::DriftFilter>>,
     /// Buffers of [`Integrator::consistent_accelerations`], kept so that the restarts of
     /// the accelerations at a contact's events allocate nothing (issue 27 §1d).
     acc: AccelerationScratch,
@@ -315,6 +318,7 @@ impl Integrator {
             acc: AccelerationScratch::sized(n, n - sys.n_node_eq, nn),
             esdirk,
             index1,
+            drift: None,
             t: 0.0,
             stats: Stats::default(),
             newton,
@@ -509,6 +513,8 @@ fn moved_along_velocities(nodes: &[NodeState], dt: f64, out: &mut Vec<NodeState>
 }
 
 mod corotated;
+mod drift;
+pub use drift::DriftState;
 mod error;
 pub mod esdirk;
 mod hht;

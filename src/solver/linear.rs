@@ -193,9 +193,16 @@ impl SparseSystem {
     /// `y = A x` with the current values.
     pub fn mul(&self, x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);
+        self.mul_add(&self.values, 1.0, x, y);
+    }
+
+    /// `y += s B x`, `B` the matrix of this pattern with the values `values` (in pattern
+    /// order, as [`Self::values`]).
+    pub fn mul_add(&self, values: &[f64], s: f64, x: &[f64], y: &mut [f64]) {
         for col in 0..self.n {
+            let sx = s * x[col];
             for k in self.col_ptr[col]..self.col_ptr[col + 1] {
-                y[self.row_idx[k]] += self.values[k] * x[col];
+                y[self.row_idx[k]] += values[k] * sx;
             }
         }
     }

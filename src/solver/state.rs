@@ -109,6 +109,8 @@ pub struct IntegratorState {
     lu: LuState,
     /// The stage schemes' index-1 solve of the reactions (its kept pivots).
     lu_index1: Option<LuState>,
+    /// The adaptive steps' drift filter (`CARRY MODES`), once built.
+    drift: Option<super::integrator::DriftState>,
     elements: Vec<ElementState>,
     /// The energy guard's record along the run ([`crate::solver::energy_guard::Balance`]).
     balance: crate::solver::energy_guard::Balance,
@@ -187,6 +189,7 @@ impl Integrator {
             rhs: self.sys.rhs.clone(),
             lu: self.sys.matrix.save_state(),
             lu_index1: self.index1_lu(),
+            drift: self.drift_state(),
             elements: self.sys.elements.iter().map(|e| e.save_state()).collect(),
             balance: self.balance,
         })
@@ -233,6 +236,7 @@ impl Integrator {
         }
         self.sys.matrix.restore_state(s.lu)?;
         self.restore_index1_lu(s.lu_index1)?;
+        self.restore_drift(s.drift)?;
         self.t = s.t;
         self.stats = s.stats;
         for (d, r) in self.nodes.iter_mut().zip(&s.nodes) {

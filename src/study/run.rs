@@ -75,6 +75,8 @@ pub(super) fn set_run(model: &mut Model, h: f64, sch: Scheme, tol: Option<f64>, 
         ..
     } = &mut model.analysis
     {
+        // The adaptive runs keep the deck's own `CARRY` (`Run` when it declares none).
+        let carry_of_deck = adaptive.as_ref().map_or(Default::default(), |a| a.carry);
         *scheme = sch;
         *step = h;
         *end = t_end;
@@ -88,6 +90,7 @@ pub(super) fn set_run(model: &mut Model, h: f64, sch: Scheme, tol: Option<f64>, 
             tol_position: tp,
             tol_rotation: tp,
             max_growth: 2.0,
+            carry: carry_of_deck,
         });
     }
 }

@@ -339,6 +339,26 @@ fn malformed_decks_table() {
             44,
             "GENALPHA",
         ),
+        // CARRY: a value, with ADAPTIVE, and MODES only for the ESDIRK schemes
+        (
+            "ANALYSIS DYNAMIC ESDIRK5 STEP 1e-3 END 1 ADAPTIVE TOLPOS 1 TOLROT 1 CARRY ALL\n"
+                .into(),
+            1,
+            75,
+            "RUN or MODES",
+        ),
+        (
+            "ANALYSIS DYNAMIC ESDIRK5 STEP 1e-3 END 1 CARRY MODES\n".into(),
+            1,
+            53,
+            "ADAPTIVE",
+        ),
+        (
+            "ANALYSIS DYNAMIC STEP 1e-3 END 1 ADAPTIVE TOLPOS 1 TOLROT 1 CARRY MODES\n".into(),
+            1,
+            61,
+            "ESDIRK3 or ESDIRK5",
+        ),
         (
             "ANALYSIS DYNAMIC STEP 0 END 1\n".into(),
             1,

@@ -168,6 +168,7 @@ this is not read",
         "ANALYSIS DYNAMIC STEP 0.1 END 1\n",
         "ANALYSIS DYNAMIC GENALPHA RHOINF 0.9 STEP 0.1 END 1 ADAPTIVE TOLPOS 1e-5 TOLROT 1e-4\n",
         "ANALYSIS DYNAMIC STEP 0.1 END 1 GENALPHA\n",
+        "ANALYSIS DYNAMIC ESDIRK5 STEP 0.1 END 1 ADAPTIVE TOLPOS 1e-5 TOLROT 1e-4 CARRY MODES\n",
     ];
     for deck in decks {
         let mut first = match parse_deck(deck, "rich.dat") {

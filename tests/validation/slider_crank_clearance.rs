@@ -172,6 +172,7 @@ fn clearance_orbit_and_slider_stay_within_the_derived_bounds() {
             tol_position: 1e-8,
             tol_rotation: 1e-6,
             max_growth: 2.0,
+            carry: Default::default(),
         });
         *max_step = 4e-5;
     }

@@ -2,7 +2,7 @@
 
 use super::cursor::*;
 use super::*;
-use crate::model::Scheme;
+use crate::model::{Carry, Scheme};
 
 /// Most Newton iterations a step may take (`MAXIT`).
 pub const MAX_NEWTON_ITERATIONS: u32 = 1000;
@@ -155,8 +155,8 @@ impl Builder<'_> {
         let kws: &[&'static str] = if kind == "DYNAMIC" {
             &[
                 "ALPHA", "GENALPHA", "RHOINF", "ESDIRK3", "ESDIRK5", "STEP", "END", "MINSTEP",
-                "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT", "GROWTH", "TOL", "TOLINC", "MAXIT",
-                "NEWTON",
+                "MAXSTEP", "ADAPTIVE", "TOLPOS", "TOLROT", "GROWTH", "CARRY", "TOL", "TOLINC",
+                "MAXIT", "NEWTON",
             ]
         } else {
             &["STEPS", "PROPORTIONAL", "TOL", "TOLINC", "MAXIT", "NEWTON"]
@@ -169,6 +169,7 @@ impl Builder<'_> {
         let (mut step, mut end, mut min, mut max) = (None, None, None, None);
         let (mut tolpos, mut tolrot, mut growth, mut steps) = (None, None, 2.0, 1);
         let mut adaptive = None;
+        let mut carry = (Carry::Run, None);
         let mut esdirk = None;
         let mut proportional = false;
         let pos = |v: f64| v > 0.0;
@@ -214,6 +215,15 @@ impl Builder<'_> {
                 "TOLPOS" => tolpos = Some(c.number_in("TOLPOS", "> 0 m", pos)?),
                 "TOLROT" => tolrot = Some(c.number_in("TOLROT", "> 0 rad", pos)?),
                 "GROWTH" => growth = c.number_in("GROWTH", ">= 1", |v| v >= 1.0)?,
+                "CARRY" => {
+                    let (v, _) = c.expect_keyword(&["RUN", "MODES"], "RUN or MODES")?;
+                    let how = if v == "MODES" {
+                        Carry::Modes
+                    } else {
+                        Carry::Run
+                    };
+                    carry = (how, Some(ks));
+                }
                 "TOL" => newton.tol_residual = c.number_in("TOL", "> 0", pos)?,
                 "TOLINC" => newton.tol_increment = c.number_in("TOLINC", "> 0", pos)?,
                 "MAXIT" => {
@@ -292,11 +302,12 @@ impl Builder<'_> {
                     tol_position: p,
                     tol_rotation: r,
                     max_growth: growth,
+                    carry: carry.0,
                 }),
                 (Some(_), None, _) => return Err(miss("TOLPOS <m> after ADAPTIVE")),
                 (Some(_), _, None) => return Err(miss("TOLROT <rad> after ADAPTIVE")),
                 (None, _, _) => {
-                    for kw in ["TOLPOS", "TOLROT", "GROWTH"] {
+                    for kw in ["TOLPOS", "TOLROT", "GROWTH", "CARRY"] {
                         if seen.has(kw) {
                             return Err(DeckError::new(
                                 K::MissingKeyword {
@@ -335,6 +346,21 @@ impl Builder<'_> {
                 }
                 (None, _) => Scheme::Hht { alpha },
             };
+            // `CARRY MODES` weighs the velocity term of the ESDIRK schemes' estimate; the α
+            // family's (Zienkiewicz–Xie's) has none to weigh.
+            if let (Carry::Modes, Some(cs)) = carry
+                && !matches!(scheme, Scheme::Esdirk3 | Scheme::Esdirk5)
+            {
+                return Err(DeckError::new(
+                    K::MissingKeyword {
+                        context: format!("CARRY MODES in {}", c.ctx),
+                        expected: "ESDIRK3 or ESDIRK5 (the α schemes' error estimate has no \
+                                   velocity term to carry)"
+                            .into(),
+                    },
+                    cs,
+                ));
+            }
             Analysis::Dynamic {
                 scheme,
                 step: h,

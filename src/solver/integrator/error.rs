@@ -9,9 +9,9 @@ impl Integrator {
     /// (Zienkiewicz & Xie, Earthquake Eng. Struct. Dyn. 20, 1991, eq. 9; the leading term
     /// of the local truncation error of Newmark-type schemes). ≤ 1 means acceptable.
     /// The ESDIRK schemes use their embedded pair instead ([`Self::embedded_error`]).
-    pub fn local_error(&self, h: f64, a: &crate::model::Adaptive) -> f64 {
+    pub fn local_error(&mut self, h: f64, a: &crate::model::Adaptive, ctx: &EvalContext) -> f64 {
         if self.is_esdirk() {
-            return self.embedded_error(h, a);
+            return self.embedded_error(h, a, ctx);
         }
         let c = h * h * (self.params.beta - 1.0 / 6.0).abs();
         let mut err: f64 = 0.0;

@@ -255,11 +255,17 @@ impl Integrator {
     /// order of the global error), and with it the global error is `∝ TOL^1.02` (ESDIRK3:
     /// `TOL^0.97`, whose `e_x` is already `O(h³)`) on the simple pendulum
     /// (`tests/study.rs`, docs/accuracy.md "Accuracy asked for").
-    pub(super) fn embedded_error(&self, h: f64, a: &crate::model::Adaptive) -> f64 {
+    pub(super) fn embedded_error(
+        &mut self,
+        h: f64,
+        a: &crate::model::Adaptive,
+        ctx: &EvalContext,
+    ) -> f64 {
         let st = self.esdirk.as_deref().expect("ESDIRK stages");
         let tab = st.tab;
         let last = tab.stages - 1;
-        let mut err = 0.0f64;
+        let mut ex = Vec::with_capacity(self.u.len());
+        let mut evs = Vec::with_capacity(self.u.len());
         for (k, u) in self.u.iter().enumerate() {
             let w_last = h * (tab.a[last][last] - tab.embedded[last]) / st.gh;
             let mut e = [
@@ -275,12 +281,29 @@ impl Integrator {
                 ev[0] += st.acc[k][j][0] * w;
                 ev[1] += st.acc[k][j][1] * w;
             }
-            // A velocity error made now displaces the positions by up to `e_v T` by the
-            // end of the run (`T` = END): the position error the step is answerable for.
-            let t = self.error_horizon;
+            ex.push(e);
+            evs.push(ev);
+        }
+        // A velocity error made now displaces the positions by up to `e_v T` by the
+        // end of the run (`T` = END) if it is a drift, by `|e_v|/ω` if it is a vibration
+        // of frequency ω ([`super::drift`]).
+        let t = self.error_horizon;
+        let z = match a.carry {
+            crate::model::Carry::Run => None,
+            crate::model::Carry::Modes => self.drift_filtered(&evs, ctx),
+        };
+        let mut err = 0.0f64;
+        for (k, (e, ev)) in ex.iter().zip(&evs).enumerate() {
+            let mut m = [t * ev[0].norm(), t * ev[1].norm()];
+            if let Some(z) = &z {
+                for c in 0..2 {
+                    let zn = z[k][c].norm().min(ev[c].norm());
+                    m[c] = t * (ev[c].norm() * zn).sqrt();
+                }
+            }
             err = err
-                .max(e[0].norm().max(t * ev[0].norm()) / a.tol_position)
-                .max(e[1].norm().max(t * ev[1].norm()) / a.tol_rotation);
+                .max(e[0].norm().max(m[0]) / a.tol_position)
+                .max(e[1].norm().max(m[1]) / a.tol_rotation);
         }
         err
     }

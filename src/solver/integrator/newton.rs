@@ -488,7 +488,7 @@ impl Integrator {
             && let Some(a) = self.adaptive.clone()
         {
             // Local error control before committing (Zienkiewicz & Xie 1991).
-            let err = self.local_error(h, &a);
+            let err = self.local_error(h, &a, &ctx);
             let factor = 0.9 * err.max(1e-12).powf(-self.error_exponent());
             if err > 1.0 && h > self.event_floor * (1.0 + crate::solver::FLOOR_SLACK) {
                 let retry = (h * factor.max(0.2)).max(self.event_floor);

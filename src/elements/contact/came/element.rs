@@ -256,6 +256,10 @@ impl Element for Came {
     fn dissipated_power(&self, nodes: &[NodeState]) -> f64 {
         self.state(nodes).map_or(0.0, |st| self.power(&st))
     }
+    fn intermittent(&self) -> bool {
+        true
+    }
+
     fn step_limit(
         &self,
         ctx: &EvalContext,

@@ -242,6 +242,10 @@ impl Element for Clearance {
         self.power(&self.state(nodes))
     }
 
+    fn intermittent(&self) -> bool {
+        true
+    }
+
     fn step_limit(
         &self,
         ctx: &EvalContext,
