@@ -37,6 +37,8 @@ enum Diff {
     Mesh,
     /// The time step (and the smallest and largest steps derived from it).
     Step,
+    /// Adaptive steps (their tolerances and their measure).
+    Adaptive,
     /// The end time.
     End,
     /// The time integrator (HHT, generalized-α, ESDIRK3) and its parameter.
@@ -242,9 +244,13 @@ fn canon(m: &Model, diffs: &[Diff]) -> Canon {
         min_step,
         max_step,
         scheme,
+        adaptive,
         ..
     } = &mut analysis
     {
+        if has(Diff::Adaptive) {
+            *adaptive = None;
+        }
         if has(Diff::Step) {
             (*step, *min_step, *max_step) = (0.0, 0.0, 0.0);
         }
@@ -329,6 +335,11 @@ const DERIVED: &[(&str, &str, &[Diff])] = &[
         "pendulum_converged.dat",
         "pendulum_flexible1.dat",
         &[Mesh, Step, End, Output, Integrator],
+    ),
+    (
+        "pendulum_adaptive.dat",
+        "pendulum_flexible1.dat",
+        &[Mesh, Step, Adaptive, End, Output, Integrator],
     ),
     (
         "pendulum_converged_beams.dat",
