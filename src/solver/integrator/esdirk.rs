@@ -87,6 +87,9 @@ pub struct Stages {
     rows: Vec<f64>,
     /// The exact `s B v` of the constrained elements (the joints, drivers, rigid bars).
     bv: super::multipliers::ConstraintVelocity,
+    /// The step's embedded position and velocity errors per node ([`Integrator::embedded_error`]).
+    err_x: Vec<Pair>,
+    err_v: Vec<Pair>,
 }
 
 impl Stages {
@@ -103,6 +106,8 @@ impl Stages {
             velocity_level: false,
             rows: Vec::new(),
             bv: super::multipliers::ConstraintVelocity::new(sys),
+            err_x: Vec::with_capacity(nodes),
+            err_v: Vec::with_capacity(nodes),
         }
     }
 }
@@ -261,11 +266,12 @@ impl Integrator {
         a: &crate::model::Adaptive,
         ctx: &EvalContext,
     ) -> f64 {
-        let st = self.esdirk.as_deref().expect("ESDIRK stages");
+        let st = self.esdirk.as_deref_mut().expect("ESDIRK stages");
+        let (mut ex, mut evs) = (std::mem::take(&mut st.err_x), std::mem::take(&mut st.err_v));
+        ex.clear();
+        evs.clear();
         let tab = st.tab;
         let last = tab.stages - 1;
-        let mut ex = Vec::with_capacity(self.u.len());
-        let mut evs = Vec::with_capacity(self.u.len());
         for (k, u) in self.u.iter().enumerate() {
             let w_last = h * (tab.a[last][last] - tab.embedded[last]) / st.gh;
             let mut e = [
@@ -295,7 +301,7 @@ impl Integrator {
         let mut err = 0.0f64;
         for (k, (e, ev)) in ex.iter().zip(&evs).enumerate() {
             let mut m = [t * ev[0].norm(), t * ev[1].norm()];
-            if let Some(z) = &z {
+            if let Some(z) = z {
                 for c in 0..2 {
                     let zn = z[k][c].norm().min(ev[c].norm());
                     m[c] = t * (ev[c].norm() * zn).sqrt();
@@ -305,6 +311,8 @@ impl Integrator {
                 .max(e[0].norm().max(m[0]) / a.tol_position)
                 .max(e[1].norm().max(m[1]) / a.tol_rotation);
         }
+        let st = self.esdirk.as_deref_mut().expect("ESDIRK stages");
+        (st.err_x, st.err_v) = (ex, evs);
         err
     }
 
