@@ -94,6 +94,42 @@ fn the_step_loop_does_not_allocate() {
     assert_eq!(n, 0, "{n} heap allocations in 50 steps");
 }
 
+/// The adaptive ESDIRK5 step with `CARRY MODES` allocates nothing either: its embedded
+/// errors and the filtered velocity error go to kept buffers, and its drift filter is rebuilt
+/// (every 1/200 of the run: here a run said to last 0.2 s, so every 1 ms, ten times in the
+/// 100 steps of 1e-4 s measured) into its own (`solver::integrator::drift`), once its LU has
+/// grown to its fill: a rebuild that re-pivots may grow it, as the iteration matrix's LU
+/// (`solver::linear`) — here once, at 5.3 ms, within the 60 steps before. The tolerance is
+/// loose enough for every step to be accepted.
+#[test]
+fn the_adaptive_esdirk_step_with_carry_modes_does_not_allocate() {
+    let path = std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/decks/pendulum_adaptive.dat"
+    ));
+    let mut model = mecano::deck::load_deck(path).expect("deck");
+    let mecano::model::Analysis::Dynamic {
+        adaptive: Some(a), ..
+    } = &mut model.analysis
+    else {
+        panic!("the deck is adaptive");
+    };
+    assert_eq!(a.carry, mecano::model::Carry::Modes);
+    (a.tol_position, a.tol_rotation) = (1.0, 1.0);
+    let adaptive = a.clone();
+    let mut integ = mecano::solver::prepare(&model).expect("prepare");
+    integ.initialize().expect("initial accelerations");
+    integ.adaptive = Some(adaptive);
+    integ.error_horizon = 0.2;
+    let h = 1e-4;
+    for _ in 0..60 {
+        integ.try_step(h).expect("step");
+    }
+    let (ok, n) = allocations_in(|| (0..100).all(|_| integ.try_step(h).is_ok()));
+    assert!(ok, "a step failed");
+    assert_eq!(n, 0, "{n} heap allocations in 100 steps");
+}
+
 /// Writing the histories allocates nothing either: every node and element of the pendulum
 /// (hinge, universal joint, 20 beams, the CAME contact, two masses) and the energies at
 /// each of the 50 steps, through `output::Writer` (csv, ryu, one reused row buffer).

@@ -47,6 +47,10 @@ pub struct DriftFilter {
     y: Vec<f64>,
     /// The last filtered velocity error per node.
     z: Vec<[Vector3<f64>; 2]>,
+    /// The elements left out of `K` ([`crate::elements::Element::intermittent`]).
+    left_out: Vec<bool>,
+    /// The residual the filter's assemblies write, swapped with the system's (kept).
+    rhs: Vec<f64>,
 }
 
 /// What a checkpoint keeps of the [`DriftFilter`], so that a resumed run estimates as the
@@ -59,16 +63,19 @@ pub struct DriftState {
 }
 
 impl DriftFilter {
-    fn sized(columns: &[Vec<usize>]) -> Option<Box<Self>> {
-        let a = SparseSystem::new(columns).ok()?;
+    /// Its buffers for `sys`, allocated once: a rebuild allocates nothing.
+    fn sized(sys: &System) -> Option<Box<Self>> {
+        let a = SparseSystem::new(&sys.matrix.columns()).ok()?;
         let n = a.dim();
         Some(Box::new(DriftFilter {
+            k: Vec::with_capacity(a.nnz()),
             a,
-            k: Vec::new(),
             built_at: f64::NAN,
             x: vec![0.0; n],
             y: vec![0.0; n],
-            z: Vec::new(),
+            z: Vec::with_capacity(sys.node_dofs.len()),
+            left_out: sys.elements.iter().map(|e| e.intermittent()).collect(),
+            rhs: vec![0.0; sys.rhs.len()],
         }))
     }
 }
@@ -122,12 +129,10 @@ impl Integrator {
         let n = self.sys.n_eq();
         let mut f = match self.drift.take() {
             Some(f) if f.a.dim() == n => f,
-            _ => DriftFilter::sized(&self.sys.matrix.columns())?,
+            _ => DriftFilter::sized(&self.sys)?,
         };
         let t_run = self.error_horizon;
-        let out: Vec<bool> = self.sys.elements.iter().map(|e| e.intermittent()).collect();
-        let rhs = std::mem::take(&mut self.sys.rhs);
-        self.sys.rhs = vec![0.0; rhs.len()];
+        std::mem::swap(&mut self.sys.rhs, &mut f.rhs);
         std::mem::swap(&mut self.sys.matrix, &mut f.a);
         let stiff = EvalContext {
             c_a: 0.0,
@@ -136,7 +141,7 @@ impl Integrator {
         };
         let (nodes, lambda) = (&self.nodes, &self.lambda);
         self.sys
-            .assemble_except(&stiff, nodes, lambda, true, None, &out);
+            .assemble_except(&stiff, nodes, lambda, true, None, &f.left_out);
         f.k.clone_from(&self.sys.matrix.values);
         let slow = EvalContext {
             c_a: 1.0 / (t_run * t_run),
@@ -144,10 +149,10 @@ impl Integrator {
             ..*ctx
         };
         self.sys
-            .assemble_except(&slow, nodes, lambda, true, None, &out);
+            .assemble_except(&slow, nodes, lambda, true, None, &f.left_out);
         let factored = self.sys.matrix.factor().is_ok();
         std::mem::swap(&mut self.sys.matrix, &mut f.a);
-        self.sys.rhs = rhs;
+        std::mem::swap(&mut self.sys.rhs, &mut f.rhs);
         f.built_at = self.t;
         self.drift = Some(f).filter(|_| factored);
         self.drift.as_ref().map(|_| ())
@@ -168,7 +173,7 @@ impl Integrator {
         let Some(s) = s else {
             return Ok(());
         };
-        let mut f = DriftFilter::sized(&self.sys.matrix.columns()).ok_or_else(|| {
+        let mut f = DriftFilter::sized(&self.sys).ok_or_else(|| {
             LinearError::State("the drift filter's matrix cannot be built".into())
         })?;
         if s.k.len() != f.a.nnz() {
